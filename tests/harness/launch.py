@@ -1,0 +1,120 @@
+"""Start real `roslaunch` / `rosrun` processes for a test and always stop them."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import subprocess
+import tempfile
+import xmlrpc.client
+from collections.abc import Iterator, Mapping, Sequence
+
+from harness.waiting import wait_until
+
+__all__ = ["Launched", "run_launch", "run_node"]
+
+
+class Launched:
+    """A launched process group with helpers to wait on what it should offer."""
+
+    def __init__(self, proc: subprocess.Popen, log_path: str) -> None:
+        self.proc = proc
+        self._log_path = log_path
+
+    def output(self) -> str:
+        """Everything the process printed so far (stdout and stderr)."""
+        with open(self._log_path, errors="replace") as log:
+            return log.read()
+
+    def _master(self) -> xmlrpc.client.ServerProxy:
+        return xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"])
+
+    def _check_alive(self) -> None:
+        if self.proc.poll() is not None:
+            raise AssertionError(f"process exited with {self.proc.returncode}:\n{self.output()[-4000:]}")
+
+    def wait_for_topic(self, name: str, timeout: float = 20.0) -> None:
+        """Waits until some node publishes `name`."""
+
+        def published() -> bool:
+            self._check_alive()
+            _, _, topics = self._master().getPublishedTopics("/harness", "")
+            return any(topic == name for topic, _ in topics)
+
+        wait_until(published, timeout, f"topic {name} to be published\n{self.output()[-4000:]}")
+
+    def wait_for_service(self, name: str, timeout: float = 20.0) -> None:
+        """Waits until service `name` is registered with the master."""
+
+        def registered() -> bool:
+            self._check_alive()
+            code, _, _ = self._master().lookupService("/harness", name)
+            return code == 1
+
+        wait_until(registered, timeout, f"service {name}\n{self.output()[-4000:]}")
+
+    def stop(self, timeout: float = 15.0) -> None:
+        if self.proc.poll() is not None:
+            return
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(self.proc.pid, signal.SIGINT)
+        try:
+            self.proc.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(self.proc.pid, signal.SIGKILL)
+            self.proc.wait()
+
+
+@contextlib.contextmanager
+def _spawn(cmd: Sequence[str], env: Mapping[str, str] | None) -> Iterator[Launched]:
+    log = tempfile.NamedTemporaryFile(prefix="harness_", suffix=".log", delete=False)
+    proc = subprocess.Popen(
+        list(cmd),
+        env=dict(os.environ if env is None else env),
+        stdin=subprocess.DEVNULL,
+        stdout=log,
+        stderr=subprocess.STDOUT,
+        start_new_session=True,
+    )
+    launched = Launched(proc, log.name)
+    try:
+        yield launched
+    finally:
+        launched.stop()
+        log.close()
+        os.unlink(log.name)
+
+
+@contextlib.contextmanager
+def run_launch(
+    package: str,
+    launch_file: str,
+    args: Mapping[str, object] | None = None,
+    env: Mapping[str, str] | None = None,
+) -> Iterator[Launched]:
+    """Runs `roslaunch package launch_file key:=value ...` against the session's master."""
+    cmd = ["roslaunch", "--wait", package, launch_file]
+    cmd += [f"{key}:={value}" for key, value in (args or {}).items()]
+    with _spawn(cmd, env) as launched:
+        yield launched
+
+
+@contextlib.contextmanager
+def run_node(
+    package: str,
+    executable: str,
+    args: Sequence[str] = (),
+    params: Mapping[str, object] | None = None,
+    name: str | None = None,
+    env: Mapping[str, str] | None = None,
+) -> Iterator[Launched]:
+    """Runs `rosrun package executable args` with private params given as `_key:=value`."""
+    cmd = ["rosrun", package, executable, *args]
+    if name:
+        cmd.append(f"__name:={name}")
+    for key, value in (params or {}).items():
+        cmd.append(f"_{key.lstrip('~_')}:={value}")
+    with _spawn(cmd, env) as launched:
+        yield launched

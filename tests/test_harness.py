@@ -1,0 +1,100 @@
+"""The test harness itself: private master, real topics, launch helpers and bags."""
+
+import subprocess
+
+import pytest
+from geometry_msgs.msg import WrenchStamped
+from harness.bags import read_bag, replay_bag, typestore, write_bag
+from harness.launch import run_node
+from harness.waiting import Collector, wait_until
+from tf2_msgs.msg import TFMessage
+
+
+def test_master_is_private_and_on_loopback(roscore):
+    assert roscore.port != 11311
+    assert roscore.uri == f"http://127.0.0.1:{roscore.port}"
+    assert roscore.is_up()
+
+
+def test_publish_and_receive_wrench(ros_node):
+    rospy = ros_node
+    collector = Collector("/harness_wrench", WrenchStamped)
+    pub = rospy.Publisher("/harness_wrench", WrenchStamped, queue_size=10)
+    wait_until(lambda: pub.get_num_connections() > 0, 10, "subscriber connection")
+    sent = WrenchStamped()
+    sent.header.frame_id = "ft_sensor"
+    sent.wrench.force.z = -4.5
+    pub.publish(sent)
+    got = collector.wait_for(1)[0]
+    assert got.header.frame_id == "ft_sensor"
+    assert got.wrench.force.z == -4.5
+    collector.close()
+    pub.unregister()
+
+
+def _wrench_bag(path, count=20, period_ns=10_000_000):
+    ts = typestore()
+    W = ts.types["geometry_msgs/msg/WrenchStamped"]
+    Header = ts.types["std_msgs/msg/Header"]
+    Time = ts.types["builtin_interfaces/msg/Time"]
+    Wrench = ts.types["geometry_msgs/msg/Wrench"]
+    V3 = ts.types["geometry_msgs/msg/Vector3"]
+    msgs = []
+    for i in range(count):
+        stamp = 1_000_000_000 + i * period_ns
+        msg = W(
+            header=Header(seq=i, stamp=Time(sec=stamp // 10**9, nanosec=stamp % 10**9), frame_id="ft_sensor"),
+            wrench=Wrench(force=V3(x=float(i), y=0.0, z=-1.0), torque=V3(x=0.0, y=0.0, z=0.5)),
+        )
+        msgs.append(("/harness_bag_wrench", "geometry_msgs/msg/WrenchStamped", stamp, msg))
+    write_bag(path, msgs)
+
+
+def test_bag_written_with_rosbags_reads_back_with_both_libraries(tmp_path):
+    path = tmp_path / "wrench.bag"
+    _wrench_bag(path)
+    back = read_bag(path)
+    assert [m.wrench.force.x for _, _, m in back] == [float(i) for i in range(20)]
+    assert back[3][1] == 1_030_000_000
+
+    rosbag = pytest.importorskip("rosbag")
+    with rosbag.Bag(str(path)) as bag:
+        got = [(topic, msg.wrench.force.x, t.to_nsec()) for topic, msg, t in bag.read_messages()]
+    assert got[5] == ("/harness_bag_wrench", 5.0, 1_050_000_000)
+    assert len(got) == 20
+
+
+def test_replay_bag_into_live_topic(ros_node, tmp_path):
+    path = tmp_path / "wrench.bag"
+    _wrench_bag(path)
+    collector = Collector("/harness_bag_wrench", WrenchStamped)
+    sent = replay_bag(path)
+    assert sent == 20
+    msgs = collector.wait_for(20, timeout=10)
+    assert [m.wrench.force.x for m in msgs] == [float(i) for i in range(20)]
+    assert all(m.header.stamp.to_sec() > 1e9 + 100 for m in msgs), "restamped to now"
+    collector.close()
+
+
+def test_run_node_starts_and_stops_a_real_node(ros_node):
+    with run_node(
+        "tf2_ros", "static_transform_publisher", args=["0", "0", "1", "0", "0", "0", "base", "harness_frame"]
+    ) as node:
+        node.wait_for_topic("/tf_static", timeout=20)
+        collector = Collector("/tf_static", TFMessage)
+        msg = collector.wait_for(1)[0]
+        assert msg.transforms[0].child_frame_id == "harness_frame"
+        assert msg.transforms[0].transform.translation.z == 1.0
+        collector.close()
+    assert node.proc.poll() is not None, "node stopped when the context ended"
+
+
+def test_launch_waits_report_a_missing_topic(ros_node):
+    identity = ["0", "0", "0", "0", "0", "0", "a", "b"]
+    with run_node("tf2_ros", "static_transform_publisher", args=identity) as node:
+        with pytest.raises(AssertionError, match="topic /never_published"):
+            node.wait_for_topic("/never_published", timeout=0.5)
+
+
+def test_roslaunch_is_available():
+    assert subprocess.run(["roslaunch", "--help"], capture_output=True).returncode == 0
