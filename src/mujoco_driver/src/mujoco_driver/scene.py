@@ -1,0 +1,292 @@
+"""Build the MuJoCo model of the scene from the URDF string and the scene settings.
+
+The scene, all in the robot's base frame (the URDF root link, which is also MuJoCo's world frame):
+  * the robot from the URDF: collision geometry only (visual meshes are dropped), every link a body
+    (``fusestatic`` off) so the F/T sensor frame and the tool exist as bodies;
+  * a table whose top is the z = 0 plane (the robot stands on it), a floor, an optional box obstacle;
+  * a site at the F/T sensor frame carrying a MuJoCo ``force`` and ``torque`` sensor;
+  * one PID joint servo per joint with inputs [position, velocity, feed-forward torque] (its I gain is
+    zero: a PD servo with velocity and torque feed-forward), force-limited by the URDF ``effort``;
+  * gravity compensation (``gravcomp``) on the arm's links but not on the sensor's subtree, so the
+    servos track tightly while the sensor still carries the tool's weight.
+
+MuJoCo's force/torque sensors report the interaction between the sensor body's subtree and its parent;
+``mujoco_driver.sim`` turns that into the wrench the environment exerts on the tool.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import xml.etree.ElementTree as ET
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from mujoco_driver.config import SceneConfig
+
+__all__ = [
+    "SceneError", "SceneModel", "UrdfJoint", "build_scene", "mujoco_urdf", "rpy_to_quat", "urdf_joints"
+]
+
+_INPUT = mujoco.mjtCtrlInput
+PID_INPUTS = int(_INPUT.mjINPUT_POS | _INPUT.mjINPUT_VEL | _INPUT.mjINPUT_FF)  # ctrl: [pos, vel, ff]
+FT_SITE = "ft_sensor_site"
+FORCE_SENSOR = "ft_force"
+TORQUE_SENSOR = "ft_torque"
+_INTEGRATORS = {
+    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+    "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
+}
+
+
+class SceneError(ValueError):
+    """Raised when the URDF and the scene settings cannot make a valid model."""
+
+
+@dataclass(frozen=True)
+class UrdfJoint:
+    """Limits of a movable URDF joint (None where the URDF gives none)."""
+
+    name: str
+    type: str
+    lower: float | None
+    upper: float | None
+    velocity: float | None
+    effort: float | None
+
+
+def rpy_to_quat(rpy: Sequence[float]) -> np.ndarray:
+    """URDF roll-pitch-yaw (fixed axes X, Y, Z) to a MuJoCo quaternion (w, x, y, z)."""
+    r, p, y = (v / 2.0 for v in rpy)
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    return np.array([
+        cr * cp * cy + sr * sp * sy,
+        sr * cp * cy - cr * sp * sy,
+        cr * sp * cy + sr * cp * sy,
+        cr * cp * sy - sr * sp * cy,
+    ])
+
+
+def _parse(urdf_xml: str) -> ET.Element:
+    try:
+        robot = ET.fromstring(urdf_xml)
+    except ET.ParseError as exc:
+        raise SceneError(f"URDF is not valid XML: {exc}") from exc
+    if robot.tag != "robot":
+        raise SceneError(f"root element is <{robot.tag}>, expected <robot>")
+    return robot
+
+
+def urdf_joints(urdf_xml: str) -> dict[str, UrdfJoint]:
+    """Movable joints of a URDF with their ``<limit>`` values, by name."""
+    joints: dict[str, UrdfJoint] = {}
+    for joint in _parse(urdf_xml).findall("joint"):
+        jtype = joint.get("type", "")
+        if jtype in ("fixed", "floating", "planar"):
+            continue
+        limit = joint.find("limit")
+
+        def value(attr: str, limit: ET.Element | None = limit) -> float | None:
+            text = limit.get(attr) if limit is not None else None
+            return float(text) if text is not None else None
+
+        lower, upper = value("lower"), value("upper")
+        if jtype == "continuous":
+            lower = upper = None
+        joints[joint.get("name", "")] = UrdfJoint(
+            joint.get("name", ""), jtype, lower, upper, value("velocity"), value("effort")
+        )
+    return joints
+
+
+def mujoco_urdf(urdf_xml: str) -> str:
+    """The URDF as MuJoCo should read it: collision only, plain mesh paths, every link a body.
+
+    Raises:
+        SceneError: On malformed XML or a mesh that is not a local file.
+    """
+    robot = _parse(urdf_xml)
+    for link in robot.findall("link"):
+        for visual in link.findall("visual"):
+            link.remove(visual)
+    for mesh in robot.iter("mesh"):
+        uri = mesh.get("filename", "")
+        path = uri[len("file://"):] if uri.startswith("file://") else uri
+        if "://" in path or not os.path.isabs(path):
+            raise SceneError(f"collision mesh {uri!r} is not an absolute path; resolve it (make_description)")
+        if not os.path.isfile(path):
+            raise SceneError(f"collision mesh {path} does not exist")
+        mesh.set("filename", path)
+    for old in robot.findall("mujoco"):
+        robot.remove(old)
+    extension = ET.SubElement(robot, "mujoco")
+    ET.SubElement(extension, "compiler", fusestatic="false", discardvisual="true", strippath="false",
+                  balanceinertia="true")
+    return ET.tostring(robot, encoding="unicode")
+
+
+@dataclass
+class SceneModel:
+    """The compiled model and the indices the simulation core needs.
+
+    Attributes:
+        model: The compiled MjModel.
+        joint_names: Movable joints, in model (and URDF tree) order.
+        qpos_adr: qpos address of each joint.
+        dof_adr: qvel address of each joint.
+        ctrl_adr: ctrl address of each joint's servo: [adr] position, [adr+1] velocity, [adr+2] torque.
+        lower: Lower position limits [rad or m] (-inf when unlimited).
+        upper: Upper position limits.
+        velocity_limit: Velocity limits from the URDF [rad/s or m/s] (inf when absent).
+        max_acceleration: Setpoint acceleration limits from the scene settings [rad/s^2 or m/s^2].
+        start_pose: Start joint positions.
+        ft_site: Site id at the F/T sensor frame.
+        force_adr: sensordata address of the force sensor (3 values).
+        torque_adr: sensordata address of the torque sensor (3 values).
+        sensor_body: Body id of the F/T sensor frame link (root of the measured subtree).
+        tool_body: Body id of the tool link (pushes are applied at its centre of mass).
+        eef_body: Body id of the end-effector frame link.
+        payload_mass: Mass below the sensor [kg].
+    """
+
+    model: mujoco.MjModel
+    joint_names: list[str]
+    qpos_adr: np.ndarray
+    dof_adr: np.ndarray
+    ctrl_adr: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    velocity_limit: np.ndarray
+    max_acceleration: np.ndarray
+    start_pose: np.ndarray
+    ft_site: int
+    force_adr: int
+    torque_adr: int
+    sensor_body: int
+    tool_body: int
+    eef_body: int
+    payload_mass: float
+
+
+def _subtree(root: mujoco.MjsBody) -> list[mujoco.MjsBody]:
+    bodies, stack = [], [root]
+    while stack:
+        body = stack.pop()
+        bodies.append(body)
+        stack.extend(body.bodies)
+    return bodies
+
+
+def _add_environment(spec: mujoco.MjSpec, cfg: SceneConfig) -> None:
+    world, table = spec.worldbody, cfg.table
+    world.add_light(name="sun", pos=[0.0, 0.0, 3.0], dir=[0.0, 0.0, -1.0])
+    world.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[3.0, 3.0, 0.1],
+                   pos=[0.0, 0.0, -table.height], rgba=[0.5, 0.5, 0.5, 1.0])
+    world.add_geom(name="table", type=mujoco.mjtGeom.mjGEOM_BOX,
+                   size=[table.size[0] / 2, table.size[1] / 2, table.thickness / 2],
+                   pos=[table.center[0], table.center[1], -table.thickness / 2], rgba=[0.6, 0.45, 0.3, 1.0])
+    if cfg.obstacle is not None:
+        obs = cfg.obstacle
+        world.add_geom(name="obstacle", type=mujoco.mjtGeom.mjGEOM_BOX, size=[s / 2 for s in obs.size],
+                       pos=list(obs.position), quat=rpy_to_quat(obs.rpy), rgba=[0.8, 0.2, 0.2, 1.0])
+
+
+def build_scene(urdf_xml: str, cfg: SceneConfig) -> SceneModel:
+    """Compile the scene.
+
+    Args:
+        urdf_xml: The robot description (meshes as absolute paths or ``file://`` URIs).
+        cfg: The validated scene settings.
+
+    Returns:
+        The compiled model with its indices.
+
+    Raises:
+        SceneError: If MuJoCo rejects the URDF, a named link is missing, a joint is not a 1-DoF hinge or
+            slide, or a per-joint setting does not match the URDF's joints.
+    """
+    limits = urdf_joints(urdf_xml)
+    try:
+        spec = mujoco.MjSpec.from_string(mujoco_urdf(urdf_xml))
+    except ValueError as exc:
+        raise SceneError(f"MuJoCo cannot read the URDF: {exc}") from exc
+    spec.option.timestep = cfg.timestep
+    spec.option.integrator = _INTEGRATORS[cfg.integrator]
+
+    bodies = {body.name: body for body in spec.bodies}
+    for role in ("ft_sensor", "tool", "eef"):
+        name = getattr(cfg.links, role)
+        if name not in bodies:
+            raise SceneError(f"links.{role}: link {name!r} not in the URDF (did make_description add it?)")
+    sensor_body = bodies[cfg.links.ft_sensor]
+    measured = {b.name for b in _subtree(sensor_body)}
+    if cfg.links.tool not in measured:
+        raise SceneError(f"links.tool {cfg.links.tool!r} not below links.ft_sensor {cfg.links.ft_sensor!r}.")
+
+    joints = [j for j in spec.joints]
+    names = [j.name for j in joints]
+    for joint in joints:
+        if joint.type not in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
+            raise SceneError(f"joint {joint.name}: only revolute/prismatic joints are supported")
+        if joint.name in measured:
+            raise SceneError(f"joint {joint.name} is below the F/T sensor; the sensor needs a rigid tool")
+    try:
+        kp = cfg.servo.kp.resolve(names)
+        kv = cfg.servo.kv.resolve(names)
+        armature = cfg.servo.armature.resolve(names)
+        start = np.array(cfg.start_pose.resolve(names))
+        max_acceleration = np.array(cfg.servo.max_acceleration.resolve(names))
+    except ValueError as exc:
+        raise SceneError(str(exc)) from exc
+
+    for body in spec.bodies:
+        if body.name != "world":
+            body.gravcomp = 0.0 if body.name in measured else 1.0
+    for joint, gain_p, gain_v, arm in zip(joints, kp, kv, armature, strict=True):
+        joint.armature = arm
+        act = spec.add_actuator(
+            name=f"{joint.name}_servo", target=joint.name, trntype=mujoco.mjtTrn.mjTRN_JOINT
+        )
+        act.set_to_pid(kp=gain_p, kv=gain_v, ctrlspec=PID_INPUTS)
+    site = sensor_body.add_site(name=FT_SITE, size=[0.01, 0.0, 0.0])
+    for sensor_name, sensor_type in ((FORCE_SENSOR, mujoco.mjtSensor.mjSENS_FORCE),
+                                     (TORQUE_SENSOR, mujoco.mjtSensor.mjSENS_TORQUE)):
+        spec.add_sensor(
+            name=sensor_name, type=sensor_type, objtype=mujoco.mjtObj.mjOBJ_SITE, objname=site.name
+        )
+    _add_environment(spec, cfg)
+    try:
+        model = spec.compile()
+    except ValueError as exc:
+        raise SceneError(f"MuJoCo cannot compile the scene: {exc}") from exc
+
+    jids = [model.joint(n).id for n in names]
+    lower = np.array([model.jnt_range[j, 0] if model.jnt_limited[j] else -np.inf for j in jids])
+    upper = np.array([model.jnt_range[j, 1] if model.jnt_limited[j] else np.inf for j in jids])
+    vel = [limits[n].velocity if n in limits and limits[n].velocity else np.inf for n in names]
+    outside = [n for n, q, lo, hi in zip(names, start, lower, upper, strict=True) if not lo <= q <= hi]
+    if outside:
+        raise SceneError(f"start_pose: joints {outside} outside their limits")
+    sensor_id = model.body(cfg.links.ft_sensor).id
+    return SceneModel(
+        model=model,
+        joint_names=names,
+        qpos_adr=np.array([model.jnt_qposadr[j] for j in jids]),
+        dof_adr=np.array([model.jnt_dofadr[j] for j in jids]),
+        ctrl_adr=np.array([model.actuator_ctrladr[model.actuator(f"{n}_servo").id] for n in names]),
+        lower=lower,
+        upper=upper,
+        velocity_limit=np.array(vel, dtype=float),
+        max_acceleration=max_acceleration,
+        start_pose=start,
+        ft_site=model.site(FT_SITE).id,
+        force_adr=int(model.sensor_adr[model.sensor(FORCE_SENSOR).id]),
+        torque_adr=int(model.sensor_adr[model.sensor(TORQUE_SENSOR).id]),
+        sensor_body=sensor_id,
+        tool_body=model.body(cfg.links.tool).id,
+        eef_body=model.body(cfg.links.eef).id,
+        payload_mass=float(model.body_subtreemass[sensor_id]),
+    )
