@@ -1,0 +1,270 @@
+"""Teleop logic: key presses and time in, the twist to publish out (no ROS, no terminal).
+
+A terminal gives no key-release events, only repeated presses while a key is held (after an initial
+delay of about 0.5 s, then about 30 per second). So motion is a deadman: the latest motion key sets the
+whole twist (one axis at a time, like the original), and the twist stays until `key_timeout` passes without
+a motion key; then zero is sent `stop_repeats` times and publishing goes quiet, so that other sources on the
+same topic (contact_control) are not overridden by a stream of zeros. The stop key sends zero at once.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
+from typing import Any, NamedTuple
+
+from keyboard_publisher.keymap import KEYMAP, Action, Binding
+
+__all__ = [
+    "MIN_SPEED_FRACTION",
+    "PARAMETERS",
+    "ZERO",
+    "KeyResult",
+    "SettingsError",
+    "TeleopSettings",
+    "TeleopState",
+    "Twist6",
+]
+
+Twist6 = tuple[float, float, float, float, float, float]
+ZERO: Twist6 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+# Speed keys multiply or divide by `speed_step`; a multiplicative step never reaches zero, so speeds are
+# kept in [MIN_SPEED_FRACTION * max, max].
+MIN_SPEED_FRACTION = 0.01
+
+# Typical keyboard auto-repeat delay; a shorter key_timeout stops motion before the first repeat arrives.
+TYPICAL_REPEAT_DELAY = 0.5
+
+# name: (default, unit, description) -- the table the README documents.
+PARAMETERS: dict[str, tuple[Any, str, str]] = {
+    "topic": ("jog_arm_server/delta_jog_cmds", "", "geometry_msgs/TwistStamped output (relative name)"),
+    "frame_id": ("", "", "header.frame_id of the twist (empty like the original: the receiver's default)"),
+    "key_event_topic": ("keyboard_publisher/key_event", "", "keyboard_publisher/KeyEvent output"),
+    "linear_speed": (0.2, "m/s", "initial linear speed (the original's fixed 0.2 m/s)"),
+    "max_linear_speed": (0.5, "m/s", "upper bound of the linear speed keys"),
+    "angular_speed": (0.3, "rad/s", "initial angular speed"),
+    "max_angular_speed": (1.0, "rad/s", "upper bound of the angular speed keys"),
+    "speed_step": (1.1, "", "factor (> 1) one speed key press multiplies or divides the speed by"),
+    "rate": (50.0, "Hz", "publish rate while moving"),
+    "key_timeout": (0.6, "s", "deadman: zero when no motion key came for this long (> the repeat delay)"),
+    "stop_repeats": (3, "", "zero twists sent after a stop or a timeout, then silence"),
+}
+
+
+class SettingsError(ValueError):
+    """A parameter has a wrong type or range; `key` names it."""
+
+    def __init__(self, key: str, message: str) -> None:
+        super().__init__(f"parameter '~{key}': {message}")
+        self.key = key
+
+
+@dataclass(frozen=True)
+class TeleopSettings:
+    """Validated parameters of key_to_twist (units in `PARAMETERS`)."""
+
+    topic: str = PARAMETERS["topic"][0]
+    frame_id: str = PARAMETERS["frame_id"][0]
+    key_event_topic: str = PARAMETERS["key_event_topic"][0]
+    linear_speed: float = PARAMETERS["linear_speed"][0]
+    max_linear_speed: float = PARAMETERS["max_linear_speed"][0]
+    angular_speed: float = PARAMETERS["angular_speed"][0]
+    max_angular_speed: float = PARAMETERS["max_angular_speed"][0]
+    speed_step: float = PARAMETERS["speed_step"][0]
+    rate: float = PARAMETERS["rate"][0]
+    key_timeout: float = PARAMETERS["key_timeout"][0]
+    stop_repeats: int = PARAMETERS["stop_repeats"][0]
+
+    def __post_init__(self) -> None:
+        for name in ("topic", "key_event_topic"):
+            value = getattr(self, name)
+            if not isinstance(value, str) or not value:
+                raise SettingsError(name, f"must be a non-empty topic name, got {value!r}")
+        if not isinstance(self.frame_id, str):
+            raise SettingsError("frame_id", f"must be a string, got {self.frame_id!r}")
+        for name in (
+            "linear_speed", "max_linear_speed", "angular_speed", "max_angular_speed", "rate", "key_timeout",
+        ):
+            _positive(name, getattr(self, name))
+        _positive("speed_step", self.speed_step)
+        if not self.speed_step > 1.0:
+            raise SettingsError("speed_step", f"must be > 1 (a factor), got {self.speed_step}")
+        if self.rate > 1000.0:
+            raise SettingsError("rate", f"must be at most 1000 Hz, got {self.rate}")
+        for speed, limit in (("linear_speed", "max_linear_speed"), ("angular_speed", "max_angular_speed")):
+            value, top = getattr(self, speed), getattr(self, limit)
+            if not MIN_SPEED_FRACTION * top <= value <= top:
+                raise SettingsError(
+                    speed, f"{value} is outside [{MIN_SPEED_FRACTION * top:g}, {top:g}] (~{limit} = {top:g})"
+                )
+        repeats = self.stop_repeats
+        if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
+            raise SettingsError("stop_repeats", f"must be an integer >= 1, got {self.stop_repeats!r}")
+
+    @classmethod
+    def from_params(cls, params: Mapping[str, Any]) -> tuple[TeleopSettings, list[str]]:
+        """Builds settings from a private-parameter dict (`rospy.get_param("~")`).
+
+        Integers are accepted for float parameters (`_rate:=50`).
+
+        Returns:
+            The settings and warnings (unknown keys, a key_timeout below the usual repeat delay).
+
+        Raises:
+            SettingsError: a value has the wrong type or range.
+        """
+        known = {f.name for f in fields(cls)}
+        warnings = [f"unknown parameter '~{key}' ignored" for key in sorted(params) if key not in known]
+        values: dict[str, Any] = {}
+        for key in known & set(params):
+            value = params[key]
+            default = PARAMETERS[key][0]
+            if isinstance(default, float) and isinstance(value, int) and not isinstance(value, bool):
+                value = float(value)
+            values[key] = value
+        settings = cls(**values)
+        if settings.key_timeout <= TYPICAL_REPEAT_DELAY:
+            warnings.append(
+                f"~key_timeout {settings.key_timeout} s is not above the usual keyboard repeat delay "
+                f"({TYPICAL_REPEAT_DELAY} s): holding a key will stutter"
+            )
+        return settings, warnings
+
+
+def _positive(name: str, value: Any) -> None:
+    number = isinstance(value, int | float) and not isinstance(value, bool)
+    if not number or not math.isfinite(value) or value <= 0:
+        raise SettingsError(name, f"must be a finite number > 0, got {value!r}")
+
+
+class KeyResult(NamedTuple):
+    """What one key press did.
+
+    Attributes:
+        binding: the key's binding, None for keys the map does not know (ignored).
+        publish_now: the command changed (new motion or stop): publish without waiting for the next tick.
+        speeds_changed: a speed key changed a speed (show the speeds again).
+        released: the previously held key, now considered released because another key came.
+    """
+
+    binding: Binding | None
+    publish_now: bool
+    speeds_changed: bool
+    released: str | None
+
+
+class TeleopState:
+    """Turns key presses and times into the twists to publish.
+
+    Args:
+        settings: validated parameters.
+    """
+
+    def __init__(self, settings: TeleopSettings) -> None:
+        self._settings = settings
+        self.linear_speed = settings.linear_speed
+        self.angular_speed = settings.angular_speed
+        self._motion: Binding | None = None
+        self._motion_time = 0.0
+        self._command: Twist6 = ZERO
+        self._zeros_left = 0
+        self._held: str | None = None
+        self._held_time = 0.0
+
+    @property
+    def settings(self) -> TeleopSettings:
+        return self._settings
+
+    def press(self, key: str, now: float) -> KeyResult:
+        """Registers a key press (or a terminal auto-repeat of it) at time `now` (s, monotonic).
+
+        Raises:
+            TypeError: `key` is not a string.
+            ValueError: `now` is not finite. The state is unchanged in both cases.
+        """
+        if not isinstance(key, str):
+            raise TypeError(f"key must be a string, got {type(key).__name__}")
+        if not math.isfinite(now):
+            raise ValueError(f"time must be finite, got {now}")
+        released = self._held if self._held is not None and self._held != key else None
+        binding = KEYMAP.get(key)
+        if binding is not None and binding.action is Action.QUIT:
+            return KeyResult(binding, False, False, released)
+        self._held, self._held_time = key, now
+        if binding is None:
+            return KeyResult(None, False, False, released)
+        if binding.action is Action.MOTION:
+            publish_now = binding != self._motion or self._expired(now)
+            self._motion, self._motion_time = binding, now
+            self._update_command()
+            return KeyResult(binding, publish_now, False, released)
+        if binding.action is Action.STOP:
+            self._stop()
+            return KeyResult(binding, True, False, released)
+        return KeyResult(binding, False, self._step_speed(binding), released)
+
+    def tick(self, now: float) -> Twist6 | None:
+        """The twist to publish at this cycle, or None when there is nothing to send (idle).
+
+        Counts the zeros sent after a stop or timeout, so call it once per published message.
+        """
+        if self._motion is not None:
+            if not self._expired(now):
+                return self._command
+            self._stop()
+        if self._zeros_left > 0:
+            self._zeros_left -= 1
+            return ZERO
+        return None
+
+    def command(self, now: float) -> Twist6:
+        """The commanded twist at `now` (zero once the deadman expired), without side effects."""
+        return self._command if self._motion is not None and not self._expired(now) else ZERO
+
+    def release(self, now: float) -> str | None:
+        """The held key, once, when no press of it came within `key_timeout` (a terminal has no releases)."""
+        if self._held is not None and now - self._held_time >= self._settings.key_timeout:
+            key, self._held = self._held, None
+            return key
+        return None
+
+    def _expired(self, now: float) -> bool:
+        return now - self._motion_time >= self._settings.key_timeout
+
+    def _stop(self) -> None:
+        self._motion = None
+        self._command = ZERO
+        self._zeros_left = self._settings.stop_repeats
+
+    def _update_command(self) -> None:
+        if self._motion is None:
+            self._command = ZERO
+            return
+        speed = self.linear_speed if self._motion.axis < 3 else self.angular_speed
+        twist = [0.0] * 6
+        twist[self._motion.axis] = self._motion.sign * speed
+        self._command = tuple(twist)  # type: ignore[assignment]
+
+    def _step_speed(self, binding: Binding) -> bool:
+        s = self._settings
+        factor = s.speed_step if binding.sign > 0 else 1.0 / s.speed_step
+        if binding.action is Action.LINEAR_SPEED:
+            old = self.linear_speed
+            self.linear_speed = _clamp(
+                old * factor, MIN_SPEED_FRACTION * s.max_linear_speed, s.max_linear_speed
+            )
+            changed = self.linear_speed != old
+        else:
+            old = self.angular_speed
+            self.angular_speed = _clamp(
+                old * factor, MIN_SPEED_FRACTION * s.max_angular_speed, s.max_angular_speed
+            )
+            changed = self.angular_speed != old
+        self._update_command()
+        return changed
+
+
+def _clamp(value: float, low: float, high: float) -> float:
+    return min(max(value, low), high)
