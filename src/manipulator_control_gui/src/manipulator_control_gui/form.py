@@ -1,0 +1,319 @@
+"""The per-axis form and its mapping to a ConfigureForceControl request (pure: no Qt, no rospy).
+
+Mapping per axis (SPEC section 3), p = request.cart_impedance_params, c = x, y or z:
+
+===================  ====================================  =====================================
+form field           X, Y, Z                               RX, RY, RZ
+===================  ====================================  =====================================
+law                  direction_control_laws.<x|y|z>.type   direction_control_laws.<rx|ry|rz>.type
+damping b            p.damping.translational.c             p.damping.rotational.c
+stiffness k          p.stiffness.translational.c           p.stiffness.rotational.c
+desired velocity     p.max_cart_vel.set.linear.c           p.max_cart_vel.set.angular.c
+max force/torque     p.max_ctrl_force.set.force.c          p.max_ctrl_force.set.torque.c
+max path deviation   p.max_path_deviation.translation.c    p.max_path_deviation.rotation.c
+===================  ====================================  =====================================
+
+Fields the axis's law does not use are sent as 0. `max_ctrl_force.exceeded_action.stop` is always true:
+contact_control ends the move when a limit is reached and supports no other action.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, replace
+from typing import Any
+
+from manipulator_control_gui.form_config import (
+    AXES,
+    AXIS_LABELS,
+    FIELDS,
+    LAW_FIELDS,
+    LAWS,
+    GuiConfig,
+    is_angular,
+)
+
+__all__ = [
+    "LAW_TYPES",
+    "AxisForm",
+    "FormError",
+    "build_request",
+    "check_with_contact_control",
+    "default_form",
+    "describe_response",
+    "form_from_dict",
+    "form_to_dict",
+    "law_form",
+    "preset_form",
+    "summarize_form",
+    "validate_form",
+    "write_request",
+]
+
+#: cartesian_impedance_msgs/ControlLaw TYPE_* of each law.
+LAW_TYPES: dict[str, int] = {"none": 0, "follower": 1, "spring": 2, "compliant_move": 3}
+
+# cartesian_impedance_msgs/CartesianForceCtrlErrorCodes, with what contact_control means by each.
+_SUCCESS = 1
+_RESPONSES: dict[int, tuple[str, str]] = {
+    99999: (
+        "FAILURE",
+        "contact control cannot take laws now (a safety stop may be latched: press Reset) "
+        "or the request was malformed",
+    ),
+    -1: ("SET_DOF_FAILED", "an axis has an unknown law"),
+    -2: ("SET_CONTROL_FORCE_FAILED", "a max force/torque is invalid or above the controller's global limit"),
+    -3: ("SET_FORCE_STIFFNESS_FAILED", "a spring stiffness k is invalid (it must be above 0)"),
+    -4: (
+        "SET_CARTESIAN_CONTROL_FAILED",
+        "a damping, desired velocity or max path deviation is invalid or above the controller's limits",
+    ),
+}
+
+
+class FormError(ValueError):
+    """The form cannot be sent; `axis` and `field` name the culprit ('' when not one field)."""
+
+    def __init__(self, message: str, axis: str = "", field: str = "", code: int | None = None) -> None:
+        super().__init__(message)
+        self.message = message
+        self.axis = axis
+        self.field = field
+        #: CartesianForceCtrlErrorCodes value when contact_control's own check refused the request.
+        self.code = code
+
+
+@dataclass(frozen=True)
+class AxisForm:
+    """One row of the form. Units per axis kind: N or N·m, m or rad, m/s or rad/s, N·s/m or N·m·s/rad."""
+
+    law: str = "none"
+    damping: float = 0.0
+    stiffness: float = 0.0
+    velocity: float = 0.0
+    max_force: float = 0.0
+    max_deviation: float = 0.0
+
+
+Form = dict[str, AxisForm]
+
+
+def default_form() -> Form:
+    """Every axis `none` (nothing moves)."""
+    return {axis: AxisForm() for axis in AXES}
+
+
+def law_form(config: GuiConfig, axis: str, law: str) -> AxisForm:
+    """The row `law` starts with on `axis` (the law's start values from the config)."""
+    return AxisForm(law, **config.start_values(law, axis))
+
+
+def preset_form(config: GuiConfig, name: str) -> Form:
+    """The form of preset `name`.
+
+    Raises:
+        KeyError: no such preset.
+    """
+    preset = config.presets[name]
+    form = default_form()
+    for axis, values in preset.axes.items():
+        row = law_form(config, axis, values["law"])
+        form[axis] = replace(row, **{k: float(v) for k, v in values.items() if k != "law"})
+    return form
+
+
+def _label(config: GuiConfig, axis: str, field: str) -> str:
+    return config.spec(field, axis).label
+
+
+def validate_form(config: GuiConfig, form: Mapping[str, AxisForm]) -> None:
+    """Checks the form before anything is sent; stops at the first problem.
+
+    Raises:
+        FormError: naming the axis and field in plain words.
+    """
+    missing = [axis for axis in AXES if axis not in form]
+    if missing:
+        raise FormError(f"The form has no row for axis {', '.join(AXIS_LABELS[a] for a in missing)}.")
+    for axis in AXES:
+        row = form[axis]
+        name = AXIS_LABELS[axis]
+        if row.law not in LAWS:
+            raise FormError(f"Axis {name}: unknown law '{row.law}'.", axis, "law")
+        law_text = config.law_labels[row.law]
+        for field in LAW_FIELDS[row.law]:
+            value = getattr(row, field)
+            spec = config.spec(field, axis)
+            what = f"Axis {name} ({law_text}): {spec.label}"
+            if not isinstance(value, int | float) or not math.isfinite(value):
+                raise FormError(f"{what} is not a number ({value}).", axis, field)
+            if value < spec.minimum or value > spec.maximum:
+                raise FormError(
+                    f"{what} {value:g} {spec.unit} is outside "
+                    f"{spec.minimum:g} to {spec.maximum:g} {spec.unit}.",
+                    axis,
+                    field,
+                )
+        if row.law in ("follower", "spring") and row.damping <= 0.0:
+            unit = config.spec("damping", axis).unit
+            raise FormError(
+                f"Axis {name} ({law_text}): damping b must be above 0 {unit} "
+                "(the law divides the force by b).",
+                axis,
+                "damping",
+            )
+        if row.law == "spring" and row.stiffness <= 0.0:
+            raise FormError(
+                f"Axis {name} (spring): stiffness k must be above 0 {config.spec('stiffness', axis).unit} "
+                "(with k = 0 nothing pulls the axis back).",
+                axis,
+                "stiffness",
+            )
+        if row.law == "compliant_move":
+            if row.velocity == 0.0:
+                raise FormError(
+                    f"Axis {name} (compliant move): desired velocity must not be 0 "
+                    f"{config.spec('velocity', axis).unit}; its sign gives the direction.",
+                    axis,
+                    "velocity",
+                )
+            if row.max_force == 0.0 and row.max_deviation == 0.0:
+                raise FormError(
+                    f"Axis {name} (compliant move): set a max force/torque or a max path deviation above 0, "
+                    "or the move would never end.",
+                    axis,
+                    "max_deviation",
+                )
+
+
+def write_request(form: Mapping[str, AxisForm], req: Any) -> Any:
+    """Writes every axis of `form` into `req` (ConfigureForceControlRequest or same-shaped tree); returns it.
+
+    Fields the axis's law does not use are written as 0, so nothing stale is sent.
+    """
+    p = req.cart_impedance_params
+    for axis in AXES:
+        row = form[axis]
+        used = LAW_FIELDS[row.law]
+        values = [getattr(row, f) if f in used else 0.0 for f in FIELDS]
+        if is_angular(axis):
+            groups = (
+                p.damping.rotational,
+                p.stiffness.rotational,
+                p.max_cart_vel.set.angular,
+                p.max_ctrl_force.set.torque,
+                p.max_path_deviation.rotation,
+            )
+        else:
+            groups = (
+                p.damping.translational,
+                p.stiffness.translational,
+                p.max_cart_vel.set.linear,
+                p.max_ctrl_force.set.force,
+                p.max_path_deviation.translation,
+            )
+        component = axis[-1]
+        for group, value in zip(groups, values, strict=True):
+            setattr(group, component, float(value))
+        getattr(req.direction_control_laws, axis).type = LAW_TYPES[row.law]
+    action = p.max_ctrl_force.exceeded_action
+    action.stop, action.gravity_compensation, action.move_away = True, False, False
+    return req
+
+
+def check_with_contact_control(req: Any) -> bool:
+    """Runs contact_control's own request validation (the node's check, without its velocity/force limits).
+
+    Returns:
+        True if the check ran, False if contact_control is not importable (then only the form was checked).
+
+    Raises:
+        FormError: contact_control would refuse the request; `code` is its CartesianForceCtrlErrorCodes value.
+    """
+    try:
+        from contact_control.request import RequestError, validate_request
+    except ImportError:
+        return False
+    try:
+        validate_request(req)
+    except RequestError as err:
+        axis = getattr(err, "axis", "")
+        raise FormError(
+            f"contact_control would refuse this: {err}", axis, "", getattr(err, "code", None)
+        ) from err
+    return True
+
+
+def build_request(config: GuiConfig, form: Mapping[str, AxisForm], req: Any = None) -> Any:
+    """Checks the form, maps it to a request and has contact_control check the request.
+
+    Args:
+        config: the form description (ranges).
+        form: the six rows.
+        req: the request object to fill; None for a new ConfigureForceControlRequest.
+
+    Raises:
+        FormError: the form or the request is invalid; nothing should be sent.
+    """
+    validate_form(config, form)
+    if req is None:
+        from cartesian_impedance_msgs.srv import ConfigureForceControlRequest
+
+        req = ConfigureForceControlRequest()
+    write_request(form, req)
+    check_with_contact_control(req)
+    return req
+
+
+def summarize_form(config: GuiConfig, form: Mapping[str, AxisForm]) -> str:
+    """'X compliant move, Z spring' or 'all axes none'."""
+    active = [f"{AXIS_LABELS[a]} {config.law_labels[form[a].law]}" for a in AXES if form[a].law != "none"]
+    return ", ".join(active) if active else "all axes none (nothing moves)"
+
+
+def describe_response(success: bool, code: int | None = None, reason: str = "") -> str:
+    """A service answer in plain words.
+
+    Args:
+        success: the response's `success`.
+        code: a CartesianForceCtrlErrorCodes value when one is known. The response's `error` field cannot
+            carry one on the wire (that message has constants only, as in the original), so the reply
+            alone gives None; contact_control_node reports the code and reason on its status topic.
+        reason: contact_control's own words for the refusal, when known.
+    """
+    if success:
+        return "Applied: contact control accepted the laws."
+    if code == _SUCCESS:
+        return "Not applied: contact control answered 'not successful' with code SUCCESS."
+    name, meaning = _RESPONSES.get(code, ("unknown code", "contact control refused the request"))
+    if reason:
+        return f"Refused: {reason} (error {name}, {code})." if code is not None else f"Refused: {reason}."
+    if code is None:
+        return (
+            "Refused: contact control did not accept the laws. They passed the same checks it makes, so "
+            "it is one of its own limits (max_velocity, global_max_force/torque) or a latched safety "
+            "stop (press Reset); its status line and log say which."
+        )
+    return f"Refused: {meaning} (error {name}, {code})."
+
+
+def form_to_dict(form: Mapping[str, AxisForm]) -> dict[str, dict[str, Any]]:
+    """Plain data (for saving the GUI's state)."""
+    return {axis: asdict(form[axis]) for axis in AXES}
+
+
+def form_from_dict(data: Mapping[str, Mapping[str, Any]]) -> Form:
+    """The inverse of `form_to_dict`; unknown axes, laws or fields are dropped (old saves stay loadable)."""
+    form = default_form()
+    for axis in AXES:
+        values = data.get(axis)
+        if not isinstance(values, Mapping) or values.get("law") not in LAWS:
+            continue
+        numbers = {}
+        for field in FIELDS:
+            value = values.get(field, 0.0)
+            if isinstance(value, int | float) and not isinstance(value, bool):
+                numbers[field] = float(value)
+        form[axis] = AxisForm(values["law"], **numbers)
+    return form

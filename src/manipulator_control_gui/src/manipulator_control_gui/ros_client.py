@@ -1,0 +1,213 @@
+"""The GUI's ROS side: service calls in worker threads, the status subscriber, a service watcher.
+
+No Qt here: every result is handed to a callback from a non-UI thread, and the widget turns those
+callbacks into Qt signals. rospy must be initialised (rospy.init_node, or rqt) before `start()`.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+__all__ = ["Availability", "CallResult", "ContactControlClient", "RosNames"]
+
+
+@dataclass(frozen=True)
+class RosNames:
+    """Where contact_control is. Relative names resolve in the GUI node's namespace."""
+
+    configure_service: str = "configure_cartesian_impedance"
+    tare_service: str = "contact_control_node/tare"
+    stop_service: str = "contact_control_node/stop"
+    reset_service: str = "contact_control_node/reset"
+    status_topic: str = "contact_control_node/status"
+
+    @classmethod
+    def from_params(cls, get_param: Callable[[str, Any], Any]) -> RosNames:
+        """Reads `~contact_control_node` (namespace of the node's private names) and per-name overrides."""
+        node = str(get_param("~contact_control_node", "contact_control_node")).rstrip("/")
+        return cls(
+            configure_service=str(get_param("~configure_service", cls.configure_service)),
+            tare_service=str(get_param("~tare_service", f"{node}/tare")),
+            stop_service=str(get_param("~stop_service", f"{node}/stop")),
+            reset_service=str(get_param("~reset_service", f"{node}/reset")),
+            status_topic=str(get_param("~status_topic", f"{node}/status")),
+        )
+
+
+@dataclass(frozen=True)
+class CallResult:
+    """How a service call went.
+
+    Attributes:
+        delivered: an answer arrived (False: the service was missing or the call failed in transport).
+        success: the answer's `success`.
+        code: an error code if the answer carried one (the ConfigureForceControl reply's error message has
+            no field, so None there; None for Trigger services too).
+        message: the Trigger answer's message, or what went wrong in transport.
+    """
+
+    delivered: bool
+    success: bool = False
+    code: int | None = None
+    message: str = ""
+
+
+@dataclass(frozen=True)
+class Availability:
+    """Result of one look at the master: `master` reachable, and the services not registered."""
+
+    master: bool
+    missing: tuple[str, ...]
+
+    @property
+    def ok(self) -> bool:
+        return self.master and not self.missing
+
+
+class ContactControlClient:
+    """Calls contact_control's services off the caller's thread and follows its status topic.
+
+    Args:
+        names: service and topic names.
+        on_status: called (from a rospy thread) with each ContactControlStatus.
+        on_availability: called (from the watcher thread) when the services appear or disappear.
+        retry_period: seconds between looks at the master.
+    """
+
+    def __init__(
+        self,
+        names: RosNames,
+        on_status: Callable[[Any], None],
+        on_availability: Callable[[Availability], None],
+        retry_period: float = 1.0,
+    ) -> None:
+        import rospy
+
+        self._rospy = rospy
+        self.names = names
+        self.resolved = RosNames(
+            *(
+                rospy.resolve_name(n)
+                for n in (
+                    names.configure_service,
+                    names.tare_service,
+                    names.stop_service,
+                    names.reset_service,
+                    names.status_topic,
+                )
+            )
+        )
+        self._on_status = on_status
+        self._on_availability = on_availability
+        self._retry_period = retry_period
+        self._stop = threading.Event()
+        self._watcher: threading.Thread | None = None
+        self._sub = None
+        self._last: Availability | None = None
+
+    def start(self) -> None:
+        """Subscribes to the status and starts watching the services."""
+        from compliant_control_msgs.msg import ContactControlStatus
+
+        self._sub = self._rospy.Subscriber(
+            self.resolved.status_topic, ContactControlStatus, self._on_status, queue_size=1
+        )
+        self._watcher = threading.Thread(target=self._watch, name="mcg-service-watcher", daemon=True)
+        self._watcher.start()
+
+    def shutdown(self) -> None:
+        """Stops the watcher and unsubscribes; calls in flight finish on their own."""
+        self._stop.set()
+        if self._sub is not None:
+            self._sub.unregister()
+            self._sub = None
+        if self._watcher is not None:
+            self._watcher.join(timeout=2.0)
+
+    def check_availability(self) -> Availability:
+        """Asks the master which of the services are registered (blocking; a watcher-thread call)."""
+        import rosgraph
+
+        master = rosgraph.Master(self._rospy.get_name())
+        missing = []
+        try:
+            for name in (
+                self.resolved.configure_service,
+                self.resolved.stop_service,
+                self.resolved.tare_service,
+                self.resolved.reset_service,
+            ):
+                try:
+                    master.lookupService(name)
+                except rosgraph.MasterError:
+                    missing.append(name)
+        except OSError:
+            return Availability(False, ())
+        return Availability(True, tuple(missing))
+
+    def _watch(self) -> None:
+        while not self._stop.is_set():
+            availability = self.check_availability()
+            if availability != self._last:
+                self._last = availability
+                self._on_availability(availability)
+            self._stop.wait(self._retry_period)
+
+    def configure(self, request: Any, on_done: Callable[[CallResult], None]) -> None:
+        """Sends `request` to the non-blocking configure service; `on_done` gets the result.
+
+        It runs in a worker thread, never the caller's (UI) thread: a hung service cannot freeze the window.
+        """
+        from cartesian_impedance_msgs.srv import ConfigureForceControl
+
+        def answer(response: Any) -> CallResult:
+            # CartesianForceCtrlErrorCodes declares constants only: a code can only come from a future field.
+            code = getattr(response.error, "val", None)
+            return CallResult(True, bool(response.success), None if code is None else int(code))
+
+        self._call(self.resolved.configure_service, ConfigureForceControl, request, answer, on_done)
+
+    def trigger(self, which: str, on_done: Callable[[CallResult], None]) -> None:
+        """Calls the std_srvs/Trigger service `which` ('stop', 'tare' or 'reset') in a worker thread."""
+        from std_srvs.srv import Trigger, TriggerRequest
+
+        name = {
+            "stop": self.resolved.stop_service,
+            "tare": self.resolved.tare_service,
+            "reset": self.resolved.reset_service,
+        }[which]
+
+        def answer(response: Any) -> CallResult:
+            return CallResult(True, bool(response.success), None, str(response.message))
+
+        self._call(name, Trigger, TriggerRequest(), answer, on_done)
+
+    def _call(
+        self,
+        name: str,
+        service_class: type,
+        request: Any,
+        answer: Callable[[Any], CallResult],
+        on_done: Callable[[CallResult], None],
+    ) -> None:
+        rospy = self._rospy
+
+        def run() -> None:
+            proxy = rospy.ServiceProxy(name, service_class)
+            try:
+                result = answer(proxy.call(request))
+            except rospy.ServiceException as err:
+                text = str(err)
+                if "unavailable" in text or "does not exist" in text:
+                    text = f"service {name} is not available (is contact_control_node running?)"
+                result = CallResult(False, message=text)
+            except (rospy.ROSException, OSError) as err:
+                result = CallResult(False, message=f"calling {name} failed: {err}")
+            finally:
+                proxy.close()
+            on_done(result)
+
+        threading.Thread(target=run, name=f"mcg-call{name.replace('/', '-')}", daemon=True).start()

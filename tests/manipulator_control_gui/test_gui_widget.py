@@ -1,0 +1,407 @@
+"""The panel against real ROS services on a real master: what a user does and sees.
+
+A stand-in contact_control (rospy services and a status publisher in this process) records what the
+panel sends. Set MCG_WRITE_SCREENSHOT=1 to also refresh the README figure (doc/screenshot.png).
+"""
+
+import itertools
+import os
+import pathlib
+import threading
+
+import pytest
+from cartesian_impedance_msgs.msg import CartesianForceCtrlErrorCodes
+from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlResponse
+from compliant_control_msgs.msg import AxisState, ContactControlStatus
+from manipulator_control_gui.form_config import AXES, load_config
+from manipulator_control_gui.ros_client import RosNames
+from std_srvs.srv import Trigger, TriggerResponse
+
+CONFIG = load_config()
+DOC_SCREENSHOT = (
+    pathlib.Path(__file__).resolve().parents[2] / "src" / "manipulator_control_gui" / "doc" / "screenshot.png"
+)
+_ids = itertools.count()
+
+
+class FakeContactControl:
+    """Services and status topic shaped like contact_control_node's, recording every call."""
+
+    def __init__(self, rospy, ns: str, success: bool = True) -> None:
+        self.rospy = rospy
+        self.requests: list = []
+        self.triggers: list[str] = []
+        self.success = success
+        self.gate = threading.Event()
+        self.gate.set()
+        node = f"{ns}/contact_control_node"
+        self.services = [
+            rospy.Service(f"{ns}/configure_cartesian_impedance", ConfigureForceControl, self._configure)
+        ]
+        for name in ("stop", "tare", "reset"):
+            self.services.append(
+                rospy.Service(f"{node}/{name}", Trigger, lambda _req, n=name: self._trigger(n))
+            )
+        self.status = rospy.Publisher(f"{node}/status", ContactControlStatus, queue_size=10)
+
+    def _configure(self, req):
+        self.requests.append(req)
+        self.gate.wait(30.0)  # a test may hold the answer back to show the window keeps running
+        # The reply's error message declares constants only (as the original): no code travels.
+        return ConfigureForceControlResponse(success=self.success, error=CartesianForceCtrlErrorCodes())
+
+    def _trigger(self, name: str) -> TriggerResponse:
+        self.triggers.append(name)
+        return TriggerResponse(success=True, message=f"{name} done by the test service")
+
+    def close(self) -> None:
+        self.gate.set()
+        for service in self.services:
+            service.shutdown()
+        self.status.unregister()
+
+
+def names_in(ns: str) -> RosNames:
+    params = {
+        "~contact_control_node": f"{ns}/contact_control_node",
+        "~configure_service": f"{ns}/configure_cartesian_impedance",
+    }
+    return RosNames.from_params(lambda key, default: params.get(key, default))
+
+
+@pytest.fixture
+def ns(ros_node) -> str:
+    return f"/gui_test_{next(_ids)}"
+
+
+@pytest.fixture
+def fake(ros_node, ns):
+    server = FakeContactControl(ros_node, ns)
+    yield server
+    server.close()
+
+
+@pytest.fixture
+def make_widget(qapp, pump):
+    from manipulator_control_gui.widget import ControlWidget
+
+    made = []
+
+    def make(ns: str):
+        widget = ControlWidget(CONFIG, names_in(ns), retry_period=0.2)
+        widget.show()
+        made.append(widget)
+        return widget
+
+    yield make
+    for widget in made:
+        widget.shutdown()
+        widget.close()
+        widget.deleteLater()
+    qapp.processEvents()
+
+
+def connected(widget) -> bool:
+    return widget.connection_label.text().startswith("Connected")
+
+
+def choose_law(widget, axis: str, law: str) -> None:
+    combo = widget.rows[axis].law_combo
+    combo.setCurrentIndex(combo.findData(law))
+
+
+def type_value(spin, text: str) -> None:
+    """Types into a spin box as a user would (select all, type, Enter)."""
+    from python_qt_binding.QtCore import Qt
+    from python_qt_binding.QtTest import QTest
+
+    spin.selectAll()
+    QTest.keyClicks(spin, text)
+    QTest.keyClick(spin, Qt.Key_Enter)
+
+
+def click(button) -> None:
+    from python_qt_binding.QtCore import Qt
+    from python_qt_binding.QtTest import QTest
+
+    QTest.mouseClick(button, Qt.LeftButton)
+
+
+def test_apply_sends_what_the_user_filled_in(fake, ns, make_widget, pump):
+    widget = make_widget(ns)
+    pump(lambda: connected(widget), message="the connection line to say connected")
+    choose_law(widget, "z", "follower")
+    type_value(widget.rows["z"].spins["damping"], "45")
+    choose_law(widget, "x", "spring")
+    type_value(widget.rows["x"].spins["stiffness"], "50")
+    choose_law(widget, "rz", "compliant_move")
+    type_value(widget.rows["rz"].spins["velocity"], "-0.1")
+    # Only the fields of the chosen law are shown.
+    assert widget.rows["z"].spins["damping"].isVisible()
+    assert not widget.rows["z"].spins["stiffness"].isVisible()
+    assert not widget.rows["z"].spins["velocity"].isVisible()
+    assert widget.rows["x"].spins["stiffness"].isVisible()
+    assert not any(spin.isVisible() for spin in widget.rows["y"].spins.values())
+
+    click(widget.apply_button)
+    pump(lambda: fake.requests, message="the request at the service")
+    pump(lambda: widget.answer_label.text().startswith("Applied"), message="the answer line")
+
+    assert len(fake.requests) == 1
+    req = fake.requests[0]
+    p = req.cart_impedance_params
+    laws = req.direction_control_laws
+    assert [getattr(laws, a).type for a in AXES] == [2, 0, 1, 0, 0, 3]
+    assert p.damping.translational.z == 45.0 and p.damping.translational.x == 30.0
+    assert p.stiffness.translational.x == 50.0 and p.stiffness.translational.z == 0.0
+    assert p.max_cart_vel.set.angular.z == -0.1 and p.max_cart_vel.set.linear.z == 0.0
+    assert p.max_ctrl_force.set.torque.z == 0.5 and p.max_path_deviation.rotation.z == 0.5
+    assert p.damping.rotational.z == 30.0
+    assert p.max_ctrl_force.exceeded_action.stop
+    assert "Applied: contact control accepted the laws." == widget.answer_label.text()
+
+
+def test_a_refusal_is_shown_in_plain_words(ros_node, ns, make_widget, pump):
+    server = FakeContactControl(ros_node, ns, success=False)
+    try:
+        widget = make_widget(ns)
+        widget.load_preset("spring_x")
+        click(widget.apply_button)
+        pump(lambda: widget.answer_label.text().startswith("Refused"), message="the refusal")
+        text = widget.answer_label.text()
+        assert text.startswith("Refused: contact control did not accept the laws.")
+        assert "press Reset" in text and "max_velocity" in text
+        assert "color: #b00020" in widget.answer_label.styleSheet()  # shown as an error
+        assert len(server.requests) == 1
+        # contact_control_node gives the reason on its status topic; the answer line picks it up.
+        status = ContactControlStatus(
+            message="no laws set; last request refused (code -3): axis x (spring): stiffness k must be > 0"
+        )
+        pump(lambda: server.status.get_num_connections() > 0, message="the status subscriber")
+        server.status.publish(status)
+        pump(lambda: "stiffness k must be > 0" in widget.answer_label.text(), message="the reason")
+        assert widget.answer_label.text() == (
+            "Refused: axis x (spring): stiffness k must be > 0 (error SET_FORCE_STIFFNESS_FAILED, -3)."
+        )
+    finally:
+        server.close()
+
+
+def test_an_invalid_form_sends_nothing(fake, ns, make_widget, pump):
+    widget = make_widget(ns)
+    pump(lambda: connected(widget), message="connected")
+    sent = []
+    real_configure = widget.client.configure
+    widget.client.configure = lambda req, done: (sent.append(req), real_configure(req, done))
+
+    choose_law(widget, "x", "spring")
+    type_value(widget.rows["x"].spins["stiffness"], "0")
+    click(widget.apply_button)
+    assert widget.answer_label.text() == (
+        "Not sent: Axis X (spring): stiffness k must be above 0 1/s (with k = 0 nothing pulls the axis back)."
+    )
+    choose_law(widget, "z", "compliant_move")
+    type_value(widget.rows["z"].spins["velocity"], "0")
+    choose_law(widget, "x", "none")
+    click(widget.apply_button)
+    assert "Axis Z (compliant move): desired velocity must not be 0" in widget.answer_label.text()
+    assert sent == []
+
+    # Corrected, it goes out, and it is the only request the service ever got.
+    type_value(widget.rows["z"].spins["velocity"], "-0.02")
+    click(widget.apply_button)
+    pump(lambda: widget.answer_label.text().startswith("Applied"), message="the corrected request's answer")
+    assert len(sent) == 1 and len(fake.requests) == 1
+    assert fake.requests[0].direction_control_laws.x.type == 0
+    assert fake.requests[0].cart_impedance_params.max_cart_vel.set.linear.z == -0.02
+
+
+def test_missing_service_is_reported_and_found_when_it_appears(ros_node, ns, make_widget, pump):
+    widget = make_widget(ns)
+    pump(lambda: "not available" in widget.connection_label.text(), message="'not available'")
+    assert f"{ns}/configure_cartesian_impedance" in widget.connection_label.text()
+    assert "retrying every 0.2 s" in widget.connection_label.text()
+
+    widget.load_preset("follower_z")
+    click(widget.apply_button)
+    pump(lambda: widget.answer_label.text().startswith("Not applied"), message="the failed call's answer")
+    assert "is not available" in widget.answer_label.text()
+
+    server = FakeContactControl(ros_node, ns)  # contact_control comes up later
+    try:
+        pump(lambda: connected(widget), message="the connection line to notice the service")
+        click(widget.apply_button)
+        pump(lambda: widget.answer_label.text().startswith("Applied"), message="the answer once it is up")
+        assert len(server.requests) == 1
+    finally:
+        server.close()
+
+
+def test_the_window_keeps_running_while_a_call_is_pending(fake, ns, make_widget, pump):
+    from python_qt_binding.QtCore import QTimer
+
+    widget = make_widget(ns)
+    pump(lambda: connected(widget), message="connected")
+    ticks = []
+    timer = QTimer()
+    timer.timeout.connect(lambda: ticks.append(1))
+    timer.start(10)
+    fake.gate.clear()  # the service holds its answer
+    try:
+        widget.load_preset("hybrid")
+        click(widget.apply_button)  # returns at once: the call runs in a worker thread
+        assert widget.answer_label.text().startswith("Sending: X compliant move, Z spring")
+        pump(lambda: fake.requests and len(ticks) >= 10, message="the event loop to run during the call")
+        assert widget.answer_label.text().startswith("Sending")  # still waiting, and not frozen:
+        click(widget.stop_button)  # Stop still works while Apply waits
+        pump(lambda: fake.triggers == ["stop"], message="the stop call")
+        pump(lambda: widget.answer_label.text().startswith("Stop done"), message="stop's answer")
+    finally:
+        fake.gate.set()
+        timer.stop()
+    pump(lambda: widget.answer_label.text().startswith("Applied"), message="the held answer")
+
+
+def test_stop_tare_reset_call_their_services(fake, ns, make_widget, pump):
+    widget = make_widget(ns)
+    for button, name in (
+        (widget.stop_button, "stop"),
+        (widget.tare_button, "tare"),
+        (widget.reset_button, "reset"),
+    ):
+        click(button)
+        pump(lambda n=name: fake.triggers[-1:] == [n], message=f"the {name} call")
+        pump(
+            lambda n=name: (
+                widget.answer_label.text() == f"{n.capitalize()} done: {n} done by the test service"
+            ),
+            message=f"{name}'s answer",
+        )
+    assert fake.triggers == ["stop", "tare", "reset"]
+    assert not fake.requests
+
+
+def publish_status(fake, pump, widget) -> ContactControlStatus:
+    status = ContactControlStatus(move_active=True, safety=ContactControlStatus.SAFETY_OK, message="")
+    status.wrench.force.x, status.wrench.force.z = 0.21, -3.4
+    status.velocity.linear.x, status.velocity.linear.z = 0.02, -0.011
+    laws = {"x": 3, "z": 2}
+    for axis in AXES:
+        status.axes.append(AxisState(axis=axis, law=laws.get(axis, 0)))
+    status.axes[0].force, status.axes[0].velocity, status.axes[0].travel = 0.21, 0.02, 0.134
+    status.axes[2].force, status.axes[2].velocity, status.axes[2].travel = -3.4, -0.011, -0.012
+    pump(lambda: fake.status.get_num_connections() > 0, message="the panel to subscribe to the status")
+    fake.status.publish(status)
+    pump(lambda: "-3.40" in widget.wrench_label.text(), message="the wrench readout")
+    return status
+
+
+def test_live_readout_follows_the_status_topic(fake, ns, make_widget, pump):
+    widget = make_widget(ns)
+    publish_status(fake, pump, widget)
+    assert widget.wrench_label.text() == "F [+0.21 +0.00 -3.40] N   T [+0.00 +0.00 +0.00] N·m"
+    assert widget.velocity_label.text().startswith("v [+0.020 +0.000 -0.011] m/s")
+    assert widget.state_label.text() == "move running · safety ok"
+    assert widget.rows["x"].readout["travel"].text() == "+0.134 m"
+    assert widget.rows["x"].readout["end"].text() == "running"
+    assert widget.rows["z"].readout["force"].text() == "-3.40 N"
+
+    ended = ContactControlStatus(
+        move_active=False, safety=ContactControlStatus.SAFETY_OK, message="x: max travel"
+    )
+    ended.axes = [AxisState(axis=a) for a in AXES]
+    ended.axes[0].end_condition = AxisState.MAX_TRAVEL
+    fake.status.publish(ended)
+    pump(
+        lambda: widget.rows["x"].readout["end"].text() == "ended: max path deviation",
+        message="the end condition",
+    )
+    assert widget.state_label.text() == "no move · safety ok · x: max travel"
+
+
+def test_preset_selector_fills_the_form_without_sending(fake, ns, make_widget, pump):
+    widget = make_widget(ns)
+    combo = widget.preset_combo
+    index = combo.findData("hybrid")
+    combo.setCurrentIndex(index)
+    combo.activated.emit(index)  # what a user's pick emits
+    form = widget.form()
+    assert (form["x"].law, form["x"].max_deviation, form["x"].velocity) == ("compliant_move", 0.3, 0.02)
+    assert (form["z"].law, form["z"].stiffness) == ("spring", 100.0)
+    assert widget.rows["x"].spins["max_deviation"].isVisible()
+    assert "Press Apply" in widget.answer_label.text()
+    assert not fake.requests
+
+
+@pytest.fixture
+def robot_fake(ros_node):
+    server = FakeContactControl(ros_node, "/robot")  # a namespace that reads naturally in the README figure
+    yield server
+    server.close()
+
+
+def test_screenshot(robot_fake, make_widget, pump, tmp_path):
+    from python_qt_binding.QtGui import QImage
+
+    widget = make_widget("/robot")
+    pump(lambda: connected(widget), message="connected")
+    widget.load_preset("hybrid")
+    click(widget.apply_button)
+    pump(lambda: widget.answer_label.text().startswith("Applied"), message="applied")
+    publish_status(robot_fake, pump, widget)
+    widget.resize(widget.sizeHint())
+    path = tmp_path / "panel.png"
+    assert widget.grab().save(str(path))
+    image = QImage(str(path))
+    assert image.width() >= 800 and image.height() >= 300
+    if os.environ.get("MCG_WRITE_SCREENSHOT"):
+        DOC_SCREENSHOT.parent.mkdir(exist_ok=True)
+        assert widget.grab().save(str(DOC_SCREENSHOT), "PNG", 9)
+        assert DOC_SCREENSHOT.stat().st_size < 300_000
+
+
+class FakeContext:
+    """What rqt hands a plugin."""
+
+    def __init__(self) -> None:
+        self.widgets = []
+
+    def serial_number(self) -> int:
+        return 2
+
+    def add_widget(self, widget) -> None:
+        self.widgets.append(widget)
+
+
+class FakeSettings:
+    def __init__(self) -> None:
+        self.data = {}
+
+    def set_value(self, key, value) -> None:
+        self.data[key] = value
+
+    def value(self, key, default=None):
+        return self.data.get(key, default)
+
+
+def test_rqt_plugin_builds_the_panel_and_keeps_the_form(qapp, ros_node):
+    from manipulator_control_gui.plugin import ManipulatorControlPlugin
+
+    context = FakeContext()
+    plugin = ManipulatorControlPlugin(context)
+    try:
+        assert context.widgets == [plugin.widget]
+        assert plugin.widget.windowTitle() == "Manipulator control (2)"
+        assert plugin.widget.client.resolved.status_topic == "/contact_control_node/status"
+        plugin.widget.load_preset("spring_x")
+        settings = FakeSettings()
+        plugin.save_settings(FakeSettings(), settings)
+        plugin.widget.load_preset("follower_z")
+        plugin.restore_settings(FakeSettings(), settings)
+        assert plugin.widget.form()["x"].law == "spring" and plugin.widget.form()["z"].law == "none"
+        settings.set_value("form", "{not json")
+        plugin.restore_settings(FakeSettings(), settings)  # ignored, form unchanged
+        assert plugin.widget.form()["x"].law == "spring"
+    finally:
+        plugin.shutdown_plugin()
+        plugin.widget.deleteLater()
