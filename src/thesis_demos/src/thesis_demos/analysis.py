@@ -1,0 +1,185 @@
+"""Judging a recorded demonstration: the figures a person would read off the plots.
+
+Pure: numpy only. A `Recording` holds time series sampled from the live stack; `judge` returns a
+`Verdict` with a one-line summary and the measured figures.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from thesis_demos.scenarios import Scenario
+
+__all__ = ["CONTACT_FORCE_BOUND", "Recording", "Verdict", "judge"]
+
+AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
+# Compliant move stops on contact without pressing harder than this [N]. Why this number: the move
+# approaches at 0.03 m/s; the controller sees the contact force through the low-pass filter and one
+# cycle of jog_arm's filter, then decelerates at its limit, so the tool keeps closing in for a few
+# tens of milliseconds against a stiff position-controlled arm. 10 N is well under the 25 N global
+# limit and the 150 N a cobot's own safety stop allows.
+CONTACT_FORCE_BOUND = 10.0
+
+
+@dataclass
+class Recording:
+    """Time series of one run; times are seconds since the laws were set."""
+
+    pose_t: np.ndarray  # (N,)
+    pose: np.ndarray  # (N, 3) tool tip position, base frame [m]
+    status_t: np.ndarray  # (M,)
+    force: np.ndarray  # (M, 3) preprocessed force the controller used, control frame [N]
+    command: np.ndarray  # (M, 3) commanded linear velocity [m/s]
+    wrench_t: np.ndarray  # (K,)
+    contact_force: np.ndarray  # (K, 3) tared sensor force rotated to the base frame [N]
+    end_conditions: dict[str, int] = field(default_factory=dict)  # axis -> AxisState end condition
+    move_end_time: float | None = None
+
+
+@dataclass
+class Verdict:
+    passed: bool
+    summary: str
+    figures: dict[str, float]
+
+
+def _window(t: np.ndarray, start: float, end: float) -> np.ndarray:
+    return (t >= start) & (t <= end)
+
+
+def _slope(t: np.ndarray, y: np.ndarray) -> float:
+    if len(t) < 3:
+        return float("nan")
+    return float(np.polyfit(t, y, 1)[0])
+
+
+def _at(rec: Recording, time: float) -> np.ndarray:
+    """The tool position at `time` (nearest sample)."""
+    return rec.pose[int(np.argmin(np.abs(rec.pose_t - time)))]
+
+
+def _before(rec: Recording, time: float) -> np.ndarray:
+    """The tool position just before `time`, e.g. where a push starts."""
+    return _at(rec, time - 0.05)
+
+
+def judge(scenario: Scenario, rec: Recording) -> Verdict:
+    """Applies the scenario's acceptance criteria to a recording."""
+    return _JUDGES[scenario.name](scenario, rec)
+
+
+def _follower(scenario: Scenario, rec: Recording) -> Verdict:
+    push, side_push = scenario.pushes
+    law = scenario.laws["z"]
+    start = _before(rec, push.start)
+    # Steady state: the second half of the push, after the filters have settled.
+    win = _window(rec.pose_t, push.start + push.duration / 2, push.end)
+    v_z = _slope(rec.pose_t[win], rec.pose[win, 2])
+    expected = push.force[2] / law.damping
+    during = _window(rec.pose_t, push.start, push.end + 0.5)
+    drift_xy = float(np.max(np.linalg.norm(rec.pose[during, :2] - start[:2], axis=1)))
+    side = _window(rec.pose_t, side_push.start, side_push.end + 0.5)
+    side_move = float(np.max(np.linalg.norm(rec.pose[side] - _before(rec, side_push.start), axis=1)))
+    tail = _window(rec.pose_t, rec.pose_t[-1] - 1.0, rec.pose_t[-1])
+    rest_speed = abs(_slope(rec.pose_t[tail], rec.pose[tail, 2]))
+    figures = {
+        "v_z [m/s]": v_z,
+        "F/b [m/s]": expected,
+        "xy drift during Z push [mm]": drift_xy * 1e3,
+        "motion under X/Y push [mm]": side_move * 1e3,
+        "speed after release [mm/s]": rest_speed * 1e3,
+    }
+    ok_speed = abs(v_z - expected) <= 0.15 * expected
+    passed = ok_speed and drift_xy < 2e-3 and side_move < 2e-3 and rest_speed < 2e-3
+    summary = (
+        f"Z followed the {push.force[2]:.0f} N push at {v_z:.3f} m/s (F/b = {expected:.3f}); "
+        f"X/Y drift {drift_xy * 1e3:.2f} mm; an X/Y push moved it {side_move * 1e3:.2f} mm; "
+        f"after release {rest_speed * 1e3:.2f} mm/s"
+    )
+    return Verdict(passed, summary, figures)
+
+
+def _compliant(scenario: Scenario, rec: Recording) -> Verdict:
+    start = rec.pose[0]
+    end = rec.pose[-1]
+    travel = float(start[2] - end[2])
+    ended_by_force = rec.end_conditions.get("z") == 1
+    peak = float(np.max(np.abs(rec.contact_force[:, 2]))) if len(rec.contact_force) else float("nan")
+    tail = _window(rec.pose_t, rec.pose_t[-1] - 0.8, rec.pose_t[-1])
+    hold = float(np.ptp(rec.pose[tail, 2])) if np.any(tail) else float("nan")
+    figures = {
+        "travel down [mm]": travel * 1e3,
+        "peak contact force [N]": peak,
+        "contact force bound [N]": CONTACT_FORCE_BOUND,
+        "motion while holding [mm]": hold * 1e3,
+    }
+    passed = travel > 0.02 and ended_by_force and peak < CONTACT_FORCE_BOUND and hold < 1e-3
+    reason = "force limit" if ended_by_force else f"end condition {rec.end_conditions.get('z')}"
+    summary = (
+        f"moved {travel * 1e3:.1f} mm down, stopped by {reason}, peak contact force {peak:.2f} N "
+        f"(bound {CONTACT_FORCE_BOUND:.0f} N), then held within {hold * 1e3:.2f} mm"
+    )
+    return Verdict(passed, summary, figures)
+
+
+def _spring(scenario: Scenario, rec: Recording) -> Verdict:
+    (push,) = scenario.pushes
+    axis = AXIS_INDEX[scenario.controlled[0]]
+    sign = float(np.sign(push.force[axis]))
+    x0 = _before(rec, push.start)[axis]
+    rel = sign * (rec.pose[:, axis] - x0)
+    during = _window(rec.pose_t, push.start, push.end)
+    after = rec.pose_t > push.end
+    excursion = float(np.max(rel[during]))
+    overshoot = float(max(0.0, -np.min(rel[after])))
+    final = float(abs(rel[-1]))
+    figures = {
+        "excursion [mm]": excursion * 1e3,
+        "return error [mm]": final * 1e3,
+        "overshoot [mm]": overshoot * 1e3,
+    }
+    passed = excursion > 1e-3 and final < 2e-3 and overshoot < 0.1 * excursion
+    summary = (
+        f"pushed {abs(push.force[axis]):.0f} N for {push.duration:.0f} s it gave way "
+        f"{excursion * 1e3:.1f} mm; "
+        f"released it came back to {final * 1e3:.2f} mm of its start, overshoot {overshoot * 1e3:.2f} mm"
+    )
+    return Verdict(passed, summary, figures)
+
+
+def _hybrid(scenario: Scenario, rec: Recording) -> Verdict:
+    (push,) = scenario.pushes
+    x_law = scenario.laws["x"]
+    start = rec.pose[0]
+    travel_x = float(abs(rec.pose[-1, 0] - start[0]))
+    ended_by_travel = rec.end_conditions.get("x") == 2
+    z0 = _before(rec, push.start)[2]
+    during = _window(rec.pose_t, push.start, push.end)
+    z_excursion = float(np.max(rec.pose[during, 2] - z0))
+    end_t = rec.move_end_time if rec.move_end_time is not None else rec.pose_t[-1]
+    z_back = float(abs(_at(rec, end_t)[2] - z0))
+    figures = {
+        "x travel [m]": travel_x,
+        "max path deviation [m]": x_law.max_travel,
+        "z excursion under push [mm]": z_excursion * 1e3,
+        "z return error [mm]": z_back * 1e3,
+    }
+    passed = (
+        ended_by_travel and abs(travel_x - x_law.max_travel) < 0.02 and z_excursion > 1e-3 and z_back < 2e-3
+    )
+    summary = (
+        f"X travelled {travel_x:.3f} m and stopped at its {x_law.max_travel:.2f} m max path deviation"
+        f"{'' if ended_by_travel else ' (NOT by MAX_TRAVEL)'}; Z gave way {z_excursion * 1e3:.1f} mm "
+        f"to the push and returned to {z_back * 1e3:.2f} mm"
+    )
+    return Verdict(passed, summary, figures)
+
+
+_JUDGES = {
+    "follower_z": _follower,
+    "compliant_move_z": _compliant,
+    "spring_x": _spring,
+    "hybrid": _hybrid,
+}

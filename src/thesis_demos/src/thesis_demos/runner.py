@@ -1,0 +1,263 @@
+"""Runs the demonstrations against a live stack, through its public ROS interface only.
+
+Services and topics used (all names are parameters of `run_demos`, defaults as the robot packages
+wire them): contact_control's `configure_cartesian_impedance`, `~tare`, `~stop`, `~reset`, `~status`;
+the MuJoCo driver's `~push`, `~reset`, `~eef_pose` and the wrist `wrench` topic; tf for the sensor's
+orientation.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import rospy
+import tf2_ros
+from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
+from compliant_control_msgs.msg import ContactControlStatus
+from compliant_control_msgs.srv import PushEEF, PushEEFRequest
+from geometry_msgs.msg import PoseStamped, WrenchStamped
+from std_srvs.srv import Trigger
+
+from thesis_demos.analysis import Recording
+from thesis_demos.scenarios import AXES, Scenario
+
+__all__ = ["DemoRunner", "Names", "build_request"]
+
+
+@dataclass(frozen=True)
+class Names:
+    """Where the stack's interfaces live."""
+
+    configure: str = "/configure_cartesian_impedance"
+    contact_control: str = "/contact_control_node"
+    driver: str = "/mujoco_driver"
+    wrench: str = "/wrench"
+    base_frame: str = "base_link"
+
+
+def build_request(scenario: Scenario) -> ConfigureForceControlRequest:
+    """The ConfigureForceControl request for a scenario (SPEC section 3 mapping)."""
+    req = ConfigureForceControlRequest()
+    p = req.cart_impedance_params
+    for axis in AXES:
+        law = scenario.laws.get(axis)
+        if law is None:
+            continue
+        getattr(req.direction_control_laws, axis).type = law.law
+        rotational = axis.startswith("r")
+        c = axis[-1]
+        setattr(p.damping.rotational if rotational else p.damping.translational, c, law.damping)
+        setattr(p.stiffness.rotational if rotational else p.stiffness.translational, c, law.stiffness)
+        setattr(p.max_cart_vel.set.angular if rotational else p.max_cart_vel.set.linear, c, law.velocity)
+        limit = p.max_ctrl_force.set
+        if rotational:
+            setattr(limit.torque, c, law.torque_limit)
+        else:
+            setattr(limit.force, c, law.force_limit)
+        setattr(
+            p.max_path_deviation.rotation if rotational else p.max_path_deviation.translation,
+            c,
+            law.max_travel,
+        )
+    p.max_ctrl_force.exceeded_action.stop = True
+    return req
+
+
+class _Series:
+    """Thread-safe append-only time series of fixed width."""
+
+    def __init__(self, width: int) -> None:
+        self.t: list[float] = []
+        self.v: list[tuple[float, ...]] = []
+        self.width = width
+        self.lock = threading.Lock()
+
+    def add(self, t: float, values: tuple[float, ...]) -> None:
+        with self.lock:
+            self.t.append(t)
+            self.v.append(values)
+
+    def clear(self) -> None:
+        with self.lock:
+            self.t.clear()
+            self.v.clear()
+
+    def arrays(self, t0: float) -> tuple[np.ndarray, np.ndarray]:
+        with self.lock:
+            t = np.asarray(self.t, dtype=float) - t0
+            v = np.asarray(self.v, dtype=float).reshape(-1, self.width)
+        keep = t >= 0.0
+        return t[keep], v[keep]
+
+
+class DemoRunner:
+    """Connects to the stack once, then runs scenarios one after another."""
+
+    def __init__(self, names: Names, timeout: float = 60.0) -> None:
+        self.names = names
+        cc, drv = names.contact_control, names.driver
+        for service in (
+            names.configure,
+            f"{cc}/tare",
+            f"{cc}/stop",
+            f"{cc}/reset",
+            f"{drv}/push",
+            f"{drv}/reset",
+        ):
+            rospy.wait_for_service(service, timeout=timeout)
+        self._configure = rospy.ServiceProxy(names.configure, ConfigureForceControl)
+        self._tare = rospy.ServiceProxy(f"{cc}/tare", Trigger)
+        self._stop = rospy.ServiceProxy(f"{cc}/stop", Trigger)
+        self._reset_safety = rospy.ServiceProxy(f"{cc}/reset", Trigger)
+        self._push = rospy.ServiceProxy(f"{drv}/push", PushEEF)
+        self._reset_sim = rospy.ServiceProxy(f"{drv}/reset", Trigger)
+        self._tf = tf2_ros.Buffer()
+        self._tf_listener = tf2_ros.TransformListener(self._tf)
+        self._pose = _Series(3)
+        self._status = _Series(6)
+        self._wrench = _Series(3)
+        self._status_lock = threading.Lock()
+        self._last_status: ContactControlStatus | None = None
+        self._sensor_rotation: np.ndarray | None = None
+        self._subs = [
+            rospy.Subscriber(f"{drv}/eef_pose", PoseStamped, self._on_pose, queue_size=100, tcp_nodelay=True),
+            rospy.Subscriber(
+                f"{cc}/status", ContactControlStatus, self._on_status, queue_size=100, tcp_nodelay=True
+            ),
+            rospy.Subscriber(names.wrench, WrenchStamped, self._on_wrench, queue_size=100, tcp_nodelay=True),
+        ]
+        self._wait(lambda: self._pose.t and self._last_status is not None, timeout, "eef_pose and status")
+
+    # --- callbacks ---
+    def _on_pose(self, msg: PoseStamped) -> None:
+        p = msg.pose.position
+        self._pose.add(msg.header.stamp.to_sec(), (p.x, p.y, p.z))
+
+    def _on_status(self, msg: ContactControlStatus) -> None:
+        f, v = msg.wrench.force, msg.velocity.linear
+        self._status.add(msg.header.stamp.to_sec(), (f.x, f.y, f.z, v.x, v.y, v.z))
+        with self._status_lock:
+            self._last_status = msg
+
+    def _on_wrench(self, msg: WrenchStamped) -> None:
+        if self._sensor_rotation is None:
+            return
+        f = msg.wrench.force
+        world = self._sensor_rotation @ np.array((f.x, f.y, f.z))
+        self._wrench.add(msg.header.stamp.to_sec(), tuple(world))
+
+    # --- helpers ---
+    @staticmethod
+    def _wait(predicate, timeout: float, what: str) -> None:
+        deadline = time.monotonic() + timeout
+        while not predicate():
+            if time.monotonic() > deadline or rospy.is_shutdown():
+                raise TimeoutError(f"timed out waiting for {what}")
+            time.sleep(0.01)
+
+    def _update_sensor_rotation(self, sensor_frame: str) -> None:
+        tf = self._tf.lookup_transform(
+            self.names.base_frame, sensor_frame, rospy.Time(0), rospy.Duration(5.0)
+        )
+        q = tf.transform.rotation
+        x, y, z, w = q.x, q.y, q.z, q.w
+        self._sensor_rotation = np.array(
+            [
+                [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+            ]
+        )
+
+    def _settle(self, timeout: float = 10.0, window: float = 0.3, tolerance: float = 2e-4) -> None:
+        """Waits until the tool has moved less than `tolerance` over `window` seconds."""
+
+        def still() -> bool:
+            with self._pose.lock:
+                if not self._pose.t or self._pose.t[-1] - self._pose.t[0] < window:
+                    return False
+                recent = [
+                    v
+                    for t, v in zip(self._pose.t, self._pose.v, strict=True)
+                    if t > self._pose.t[-1] - window
+                ]
+            return float(np.ptp(np.asarray(recent), axis=0).max()) < tolerance
+
+        self._pose.clear()
+        self._wait(still, timeout, "the arm to settle")
+
+    def _move_state(self) -> tuple[bool, dict[str, int]]:
+        with self._status_lock:
+            status = self._last_status
+        ends = {a.axis: a.end_condition for a in status.axes} if status else {}
+        return bool(status and status.move_active), ends
+
+    # --- one scenario ---
+    def run(self, scenario: Scenario, sensor_frame: str) -> Recording:
+        """Resets the scene, sets the scenario's laws, pushes, and records until done."""
+        self._stop()
+        result = self._reset_sim()
+        if not result.success:
+            raise RuntimeError(f"driver reset failed: {result.message}")
+        self._settle()
+        self._reset_safety()
+        tare = self._tare()
+        if not tare.success:
+            raise RuntimeError(f"tare failed: {tare.message}")
+        self._update_sensor_rotation(sensor_frame)
+        for series in (self._pose, self._status, self._wrench):
+            series.clear()
+        time.sleep(0.3)  # a baseline of the tared sensor before the laws start (plotted, not timed)
+        baseline_t = rospy.get_time()
+        response = self._configure(build_request(scenario))
+        if not response.success:
+            raise RuntimeError(f"{scenario.name}: contact_control refused the request (see its ~status)")
+        t0 = rospy.get_time()
+        pushes = sorted(scenario.pushes, key=lambda p: p.start)
+        end_time = None
+        while not rospy.is_shutdown():
+            now = rospy.get_time() - t0
+            while pushes and now >= pushes[0].start:
+                push = pushes.pop(0)
+                req = PushEEFRequest(duration=push.duration)
+                req.wrench.force.x, req.wrench.force.y, req.wrench.force.z = push.force
+                self._push(req)
+            active, _ = self._move_state()
+            if end_time is None and not active and now > 0.2:
+                end_time = now
+            if now >= scenario.duration:
+                break
+            if scenario.end_when_move_ends and end_time is not None and now >= end_time + scenario.settle:
+                break
+            time.sleep(0.005)
+        _, ends = self._move_state()
+        self._stop()
+        return self._recording(t0, baseline_t, ends, end_time)
+
+    def _recording(
+        self, t0: float, baseline_t: float, ends: dict[str, int], end_time: float | None
+    ) -> Recording:
+        pose_t, pose = self._pose.arrays(t0)
+        status_t, status = self._status.arrays(t0)
+        wrench_t_all, wrench_all = self._wrench.arrays(baseline_t)
+        before = wrench_t_all < (t0 - baseline_t)
+        bias = wrench_all[before].mean(axis=0) if np.any(before) else np.zeros(3)
+        after = ~before
+        return Recording(
+            pose_t=pose_t,
+            pose=pose,
+            status_t=status_t,
+            force=status[:, :3],
+            command=status[:, 3:],
+            wrench_t=wrench_t_all[after] - (t0 - baseline_t),
+            contact_force=wrench_all[after] - bias,
+            end_conditions=ends,
+            move_end_time=end_time,
+        )
+
+    def close(self) -> None:
+        for sub in self._subs:
+            sub.unregister()

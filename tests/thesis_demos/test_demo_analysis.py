@@ -1,0 +1,102 @@
+"""The demonstrations' verdicts: synthetic recordings that should pass, and ones that must fail."""
+
+import numpy as np
+import pytest
+from thesis_demos.analysis import CONTACT_FORCE_BOUND, Recording, judge
+from thesis_demos.scenarios import SCENARIOS, by_name
+
+RATE = 500.0
+
+
+def _recording(duration, x=None, y=None, z=None, ends=None, end_time=None, contact_z=None):
+    t = np.arange(0.0, duration, 1.0 / RATE)
+    pose = np.zeros((len(t), 3))
+    for i, f in enumerate((x, y, z)):
+        if f is not None:
+            pose[:, i] = [f(ti) for ti in t]
+    contact = np.zeros((len(t), 3))
+    if contact_z is not None:
+        contact[:, 2] = [contact_z(ti) for ti in t]
+    zeros = np.zeros((len(t), 3))
+    return Recording(t, pose, t, zeros, zeros, t, contact, ends or {}, end_time)
+
+
+def _ramp(start, end, speed):
+    return lambda t: speed * (min(max(t, start), end) - start)
+
+
+def test_follower_passes_at_f_over_b_and_fails_when_too_slow():
+    scenario = by_name(["follower_z"])[0]
+    push = scenario.pushes[0]
+    good = _recording(scenario.duration, z=_ramp(push.start, push.end, 5.0 / 30.0))
+    assert judge(scenario, good).passed
+    slow = _recording(scenario.duration, z=_ramp(push.start, push.end, 0.8 * 5.0 / 30.0))
+    assert not judge(scenario, slow).passed
+
+
+def test_follower_fails_when_the_side_push_moves_the_arm():
+    scenario = by_name(["follower_z"])[0]
+    push, side = scenario.pushes
+    rec = _recording(
+        scenario.duration, x=_ramp(side.start, side.end, 0.01), z=_ramp(push.start, push.end, 1 / 6)
+    )
+    verdict = judge(scenario, rec)
+    assert not verdict.passed
+    assert verdict.figures["motion under X/Y push [mm]"] > 2.0
+
+
+def test_compliant_move_needs_force_stop_low_peak_and_hold():
+    scenario = by_name(["compliant_move_z"])[0]
+
+    def rec(ends, peak):
+        return _recording(
+            5.0,
+            z=_ramp(0.0, 2.5, -0.03),
+            ends={"z": ends},
+            end_time=2.5,
+            contact_z=lambda t: peak if 2.4 < t < 2.6 else 0.0,
+        )
+
+    assert judge(scenario, rec(1, 3.0)).passed
+    assert not judge(scenario, rec(2, 3.0)).passed, "ended by travel, not by contact"
+    assert not judge(scenario, rec(1, CONTACT_FORCE_BOUND + 1)).passed, "pressed too hard"
+
+
+def test_spring_return_and_overshoot():
+    scenario = by_name(["spring_x"])[0]
+    (push,) = scenario.pushes
+
+    def x(overshoot, final):
+        def f(t):
+            if t < push.start:
+                return 0.0
+            if t < push.end:
+                return 0.005
+            if t < push.end + 0.3:
+                return -overshoot
+            return final
+
+        return f
+
+    assert judge(scenario, _recording(scenario.duration, x=x(0.0002, 0.0005))).passed
+    assert not judge(scenario, _recording(scenario.duration, x=x(0.001, 0.0))).passed, "overshoot 20%"
+    assert not judge(scenario, _recording(scenario.duration, x=x(0.0, 0.003))).passed, "did not return"
+
+
+def test_hybrid_needs_travel_stop_and_z_return():
+    scenario = by_name(["hybrid"])[0]
+    (push,) = scenario.pushes
+
+    def z(t):
+        return 0.004 if push.start < t < push.end else 0.0
+
+    good = _recording(8.0, x=_ramp(0.0, 6.0, -0.05), z=z, ends={"x": 2}, end_time=6.0)
+    assert judge(scenario, good).passed
+    short = _recording(8.0, x=_ramp(0.0, 4.0, -0.05), z=z, ends={"x": 1}, end_time=4.0)
+    assert not judge(scenario, short).passed
+
+
+def test_unknown_demo_name_is_refused():
+    with pytest.raises(KeyError, match="unknown demo"):
+        by_name(["nope"])
+    assert [s.name for s in by_name([])] == [s.name for s in SCENARIOS]
