@@ -1,0 +1,455 @@
+"""ContactControl: wrench preprocessing plus the six axis laws, one `update` per wrench.
+
+Decisions (the README repeats them):
+- A move runs from `set_laws` until any active axis meets an end condition (force/torque limit, max travel,
+  force jump), `stop()`, a new request, a global-limit trip or prolonged missing data; then every axis holds
+  still (zero velocity) and the result says which axis and condition ended it.
+- NaN/inf wrench: zero output in that same cycle (SAFETY_NAN); the move resumes with the next valid wrench.
+- Stale wrench (none for `wrench_timeout`, or a header stamp older than that): zero output (SAFETY_STALE) from
+  `check_stale`, which the node calls from its timer; after `no_data_end_timeout` the move ends (NO_FT_DATA).
+- Wrench over `global_max_force`/`global_max_torque`: zero output, the move ends (FT_VIOLATION on its active
+  axes) and the safety stays latched, refusing new laws, until `reset_safety()`.
+- After any pause the velocity restarts from zero under the acceleration limit.
+
+Not thread-safe: the node serialises calls with one lock.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from contact_control.axes import (
+    AXES,
+    END_DIFF_VIOLATION,
+    END_EXTERNAL_STOP,
+    END_FT_VIOLATION,
+    END_MAX_TRAVEL,
+    END_NAMES,
+    END_NO_FT_DATA,
+    END_NONE,
+    LAW_FOLLOWER,
+    LAW_NONE,
+    SAFETY_NAN,
+    SAFETY_OK,
+    SAFETY_OVER_LIMIT,
+    SAFETY_STALE,
+)
+from contact_control.laws import AxisLaw, ForceWindow, check_end, law_velocity, shape_velocity
+from contact_control.params import ContactControlSettings
+from contact_control.preprocess import PreprocessError, WrenchPreprocessor, is_finite6
+from contact_control.request import FAILURE, RequestError
+from contact_control.travel import TravelMeter
+
+__all__ = ["AxisState", "ContactControl", "CycleResult"]
+
+_ZEROS = (0.0,) * 6
+
+
+class AxisState(NamedTuple):
+    """One axis of a cycle, as in compliant_control_msgs/AxisState."""
+
+    axis: str
+    law: int
+    end_condition: int
+    force: float
+    velocity: float
+    travel: float
+
+
+class CycleResult:
+    """The outcome of one cycle. Lists are fresh each cycle, so a result may be kept.
+
+    Attributes:
+        t: cycle time [s].
+        velocity: commanded twist (vx, vy, vz [m/s], wx, wy, wz [rad/s]) in the control frame.
+        wrench: preprocessed wrench in the control frame [N, Nm] (the last valid one while holding).
+        travel: travel since the law was set [m, rad].
+        laws: law type per axis.
+        end_conditions: end condition per axis (non-zero on the axis that ended the move).
+        move_active: laws set and no end condition met.
+        safety: SAFETY_* code; message: why, in words ('' when all is well).
+        ended_axis: index of the axis that ended the move, -1 if none or not a single axis.
+        move_id: counts `set_laws` calls.
+    """
+
+    __slots__ = (
+        "end_conditions",
+        "ended_axis",
+        "laws",
+        "message",
+        "move_active",
+        "move_id",
+        "safety",
+        "t",
+        "travel",
+        "velocity",
+        "wrench",
+    )
+
+    def __init__(
+        self,
+        t: float,
+        velocity: list[float],
+        wrench: list[float],
+        travel: list[float],
+        laws: list[int],
+        end_conditions: list[int],
+        move_active: bool,
+        safety: int,
+        message: str,
+        ended_axis: int,
+        move_id: int,
+    ) -> None:
+        self.t = t
+        self.velocity = velocity
+        self.wrench = wrench
+        self.travel = travel
+        self.laws = laws
+        self.end_conditions = end_conditions
+        self.move_active = move_active
+        self.safety = safety
+        self.message = message
+        self.ended_axis = ended_axis
+        self.move_id = move_id
+
+    @property
+    def twist(self) -> np.ndarray:
+        """The commanded twist as a numpy array (6,), control frame."""
+        return np.array(self.velocity)
+
+    @property
+    def axes(self) -> list[AxisState]:
+        return [
+            AxisState(
+                AXES[i],
+                self.laws[i],
+                self.end_conditions[i],
+                self.wrench[i],
+                self.velocity[i],
+                self.travel[i],
+            )
+            for i in range(6)
+        ]
+
+    def __repr__(self) -> str:
+        return (
+            f"CycleResult(t={self.t}, velocity={self.velocity}, safety={self.safety}, "
+            f"move_active={self.move_active}, message={self.message!r})"
+        )
+
+
+class ContactControl:
+    """Preprocessing and the six axis laws; see the module docstring for the stop/resume rules."""
+
+    def __init__(self, settings: ContactControlSettings | None = None) -> None:
+        s = settings or ContactControlSettings()
+        self.settings = s
+        self.preprocessor = WrenchPreprocessor(s)
+        self._tuning = tuple(s.tuning(i >= 3) for i in range(6))
+        self._timeout = s.wrench_timeout
+        self._end_timeout = s.no_data_end_timeout
+        self._check_age = s.check_stamp_age
+        self._dt_nominal = 1.0 / s.control_rate
+        self._diff = tuple(t.diff_max for t in self._tuning)
+        self._windows = [ForceWindow(s.diff_window) for _ in range(6)]
+        self._meter = TravelMeter(s.travel_directions)
+        self._laws: list[AxisLaw] = [AxisLaw()] * 6
+        self._law_types = [LAW_NONE] * 6
+        self._active: tuple[int, ...] = ()
+        self._diff_axes: tuple[int, ...] = ()
+        self._needs_travel = False
+        self._v = [0.0] * 6
+        self._travel = [0.0] * 6
+        self._wrench = [0.0] * 6
+        self._end = [END_NONE] * 6
+        self._ended_axis = -1
+        self._move_active = False
+        self._move_id = 0
+        self._move_t0: float | None = None
+        self._end_ok = True
+        self._end_message = "no move yet"
+        self._outcomes: dict[int, bool] = {}
+        self._latched = False
+        self._latch_message = ""
+        self._last_rx: float | None = None
+        self._last_t: float | None = None
+        self._tare_pending = s.tare_on_startup
+        self._last_raw: Sequence[float] | None = None
+        self._last_R: Any = None
+        self.last_result = self._result(0.0, SAFETY_STALE, "no wrench yet")
+
+    # --- state ---
+    @property
+    def move_active(self) -> bool:
+        return self._move_active
+
+    @property
+    def move_id(self) -> int:
+        return self._move_id
+
+    @property
+    def end_ok(self) -> bool:
+        """Whether the last move ended by an axis end condition (force limit, max travel, force jump)."""
+        return self._end_ok
+
+    def move_outcome(self, move_id: int) -> bool | None:
+        """None while move `move_id` runs; then whether it ended by an axis end condition (see `end_ok`)."""
+        if move_id == self._move_id and self._move_active:
+            return None
+        return self._outcomes.get(move_id, False)
+
+    @property
+    def end_message(self) -> str:
+        return self._end_message
+
+    @property
+    def laws(self) -> tuple[AxisLaw, ...]:
+        return tuple(self._laws)
+
+    @property
+    def needs_travel(self) -> bool:
+        """Whether the running move uses travel (spring, compliant move, max travel): needs EEF poses."""
+        return self._move_active and self._needs_travel
+
+    @property
+    def safety_latched(self) -> bool:
+        return self._latched
+
+    # --- commands ---
+    def set_laws(
+        self,
+        laws: Sequence[AxisLaw],
+        eef_pose: Any = None,
+        t: float | None = None,
+        R_fixed_control: Any = None,
+    ) -> int:
+        """Starts a move with six laws (x, y, z, rx, ry, rz), replacing any running move at once.
+
+        Args:
+            laws: validated laws (see `request.validate_request`).
+            eef_pose: 4x4 EEF pose in the fixed frame at the start; None: taken from the next `update`.
+            t: current time [s] (for the no-data end timeout).
+            R_fixed_control: control frame orientation at the start (3x3); None: the fixed frame's.
+
+        Returns:
+            The new move id.
+
+        Raises:
+            RequestError: the global safety is latched (reset first); nothing changes.
+            ValueError: not six AxisLaw; nothing changes.
+        """
+        laws = list(laws)
+        if len(laws) != 6 or not all(isinstance(law, AxisLaw) for law in laws):
+            raise ValueError("set_laws needs six AxisLaw (x, y, z, rx, ry, rz)")
+        if self._latched:
+            raise RequestError(FAILURE, f"safety latched ({self._latch_message}); call reset first")
+        if self._move_active:
+            self._end_move(-1, END_EXTERNAL_STOP, False, "replaced by a new request")
+        self._laws = laws
+        self._law_types = [law.law for law in laws]
+        self._active = tuple(i for i in range(6) if laws[i].law != LAW_NONE)
+        self._diff_axes = tuple(i for i in self._active if self._diff[i] > 0.0)
+        self._needs_travel = any(law.law != LAW_FOLLOWER or law.max_travel > 0.0 for law in laws if law.law)
+        for window in self._windows:
+            window.clear()
+        self._v = [0.0] * 6
+        self._travel = [0.0] * 6
+        self._end = [END_NONE] * 6
+        self._ended_axis = -1
+        self._move_id += 1
+        self._move_t0 = t
+        self._last_t = None
+        self._meter.clear()
+        if eef_pose is not None:
+            self._meter.start(eef_pose, R_fixed_control)
+        self._move_active = bool(self._active)
+        self._end_ok = True
+        self._end_message = "" if self._active else "no laws set"
+        if not self._active:
+            self._outcomes[self._move_id] = True
+        return self._move_id
+
+    def stop(self, reason: str = "stop requested") -> bool:
+        """Ends the running move (EXTERNAL_STOP); returns whether one was running."""
+        if not self._move_active:
+            return False
+        self._end_move(-1, END_EXTERNAL_STOP, False, reason)
+        return True
+
+    def tare(self, wrench: Sequence[float] | None = None, R_world_sensor: Any = None) -> tuple[float, ...]:
+        """Zeroes the sensor at the current (or given) reading; see `WrenchPreprocessor.tare`.
+
+        Raises:
+            PreprocessError: no valid wrench to tare with; the bias is unchanged.
+        """
+        if wrench is None:
+            if self._last_raw is None:
+                raise PreprocessError("no wrench received yet")
+            wrench, R_world_sensor = self._last_raw, self._last_R
+        bias = self.preprocessor.tare(wrench, R_world_sensor)
+        self._tare_pending = False
+        return bias
+
+    def reset_safety(self) -> bool:
+        """Clears a latched global-limit trip; returns whether it was latched."""
+        was = self._latched
+        self._latched = False
+        self._latch_message = ""
+        return was
+
+    # --- cycles ---
+    def update(
+        self,
+        wrench: Sequence[float],
+        t: float,
+        T_control_sensor: Any = None,
+        R_world_sensor: Any = None,
+        eef_pose: Any = None,
+        R_fixed_control: Any = None,
+        stamp: float | None = None,
+    ) -> CycleResult:
+        """One control cycle for a received wrench.
+
+        Args:
+            wrench: (fx, fy, fz, tx, ty, tz) [N, Nm] in the sensor frame.
+            t: receive time [s], same clock as every other call.
+            T_control_sensor: 4x4 sensor pose in the control frame; None: same frame.
+            R_world_sensor: 3x3 sensor orientation in the fixed frame (for tool gravity).
+            eef_pose: 4x4 EEF pose in the fixed frame (for travel); None: travel not updated.
+            R_fixed_control: control frame orientation at the move's start, used if the start is taken now.
+            stamp: the wrench's header time [s] or None; older than wrench_timeout counts as no data.
+        """
+        if stamp is not None and self._check_age and t - stamp > self._timeout:
+            return self._hold(
+                t, SAFETY_STALE, f"wrench stamp is {t - stamp:.3f} s old (wrench_timeout {self._timeout} s)"
+            )
+        self._last_rx = t
+        if self._tare_pending and is_finite6(wrench):
+            self.preprocessor.tare(wrench, R_world_sensor)
+            self._tare_pending = False
+        self._last_raw, self._last_R = wrench, R_world_sensor
+        code, w = self.preprocessor.process(wrench, T_control_sensor, R_world_sensor)
+        if code != SAFETY_OK:
+            if code == SAFETY_NAN:
+                return self._hold(t, SAFETY_NAN, "wrench contains NaN or inf: holding until valid data")
+            self._trip(w)
+        if self._latched:
+            return self._hold(t, SAFETY_OVER_LIMIT, self._latch_message)
+        self._wrench = w
+        if not self._move_active:
+            return self._result(t, SAFETY_OK, "")
+        travel = self._travel
+        if eef_pose is not None:
+            if not self._meter.started:
+                self._meter.start(eef_pose, R_fixed_control)
+            self._meter.measure(eef_pose, travel)
+        laws = self._laws
+        for i in self._active:
+            end = check_end(laws[i], w[i], travel[i])
+            if end:
+                return self._end_and_hold(t, i, end)
+        for i in self._diff_axes:
+            if self._windows[i].add(t, w[i]) > self._diff[i]:
+                return self._end_and_hold(t, i, END_DIFF_VIOLATION)
+        last = self._last_t
+        dt = self._dt_nominal if last is None else min(max(t - last, 0.0), self._timeout)
+        self._last_t = t
+        v, tuning = self._v, self._tuning
+        for i in self._active:
+            v[i] = shape_velocity(law_velocity(laws[i], tuning[i], w[i], travel[i]), v[i], tuning[i], dt)
+        return self._result(t, SAFETY_OK, "")
+
+    def check_stale(self, t: float) -> CycleResult | None:
+        """Timer check: None while wrenches are fresh, else a zero-output result (SAFETY_STALE).
+
+        Ends the move with NO_FT_DATA once data has been missing for `no_data_end_timeout`.
+        """
+        last = self._last_rx
+        if last is not None and t - last <= self._timeout:
+            return None
+        if self._move_active:
+            since = last if last is not None else self._move_t0
+            if self._move_t0 is not None and (since is None or since < self._move_t0):
+                since = self._move_t0
+            if since is not None and t - since >= self._end_timeout:
+                self._end_move(-1, END_NO_FT_DATA, False, f"no wrench for {t - since:.3f} s")
+        age = "no wrench received yet" if last is None else f"no wrench for {t - last:.3f} s"
+        if self._latched:  # the latch outranks staleness: it needs a reset, data alone will not clear it
+            return self._hold(t, SAFETY_OVER_LIMIT, f"{self._latch_message}; {age}")
+        return self._hold(t, SAFETY_STALE, f"{age} (wrench_timeout {self._timeout} s)")
+
+    def hold(self, t: float, safety: int, message: str, received: bool = True) -> CycleResult:
+        """Zero output for a reason found outside (e.g. SAFETY_NO_TF); the move resumes on the next update.
+
+        Args:
+            received: a wrench did arrive at `t` (so the stale check does not also fire).
+        """
+        if received:
+            self._last_rx = t
+        return self._hold(t, safety, message)
+
+    # --- internals ---
+    def _result(self, t: float, safety: int, message: str) -> CycleResult:
+        if not message and not self._move_active:
+            message = self._end_message
+        result = CycleResult(
+            t,
+            list(self._v),
+            self._wrench,
+            list(self._travel),
+            list(self._law_types),
+            list(self._end),
+            self._move_active,
+            safety,
+            message,
+            self._ended_axis,
+            self._move_id,
+        )
+        self.last_result = result
+        return result
+
+    def _hold(self, t: float, safety: int, message: str) -> CycleResult:
+        self._v = [0.0] * 6
+        self._last_t = None  # restart the rate limits from rest
+        return self._result(t, safety, message)
+
+    def _end_and_hold(self, t: float, axis: int, condition: int) -> CycleResult:
+        law, name = self._laws[axis], AXES[axis]
+        if condition == END_FT_VIOLATION:
+            why = f"|{self._wrench[axis]:.3g}| reached the limit {law.force_limit}"
+        elif condition == END_MAX_TRAVEL:
+            why = f"travel |{self._travel[axis]:.4g}| reached the max path deviation {law.max_travel}"
+        else:
+            why = f"force changed by more than {self._diff[axis]} within the window"
+        self._end_move(axis, condition, True, f"axis {name}: {END_NAMES[condition]}: {why}")
+        return self._hold(t, SAFETY_OK, "")
+
+    def _end_move(self, axis: int, condition: int, ok: bool, message: str) -> None:
+        self._end = [END_NONE] * 6
+        if axis >= 0:
+            self._end[axis] = condition
+        else:
+            for i in self._active:
+                self._end[i] = condition
+        self._ended_axis = axis
+        self._move_active = False
+        self._end_ok = ok
+        self._end_message = f"move ended: {message}"
+        self._outcomes[self._move_id] = ok
+        self._outcomes.pop(self._move_id - 64, None)  # keep the last few for blocking callers
+        self._v = [0.0] * 6
+
+    def _trip(self, w: list[float] | None) -> None:
+        force = (w[0] ** 2 + w[1] ** 2 + w[2] ** 2) ** 0.5 if w else float("nan")
+        torque = (w[3] ** 2 + w[4] ** 2 + w[5] ** 2) ** 0.5 if w else float("nan")
+        p = self.preprocessor
+        self._latched = True
+        self._latch_message = (
+            f"wrench over the global limit (|F| {force:.1f} N of {p.max_force} N, |T| "
+            f"{torque:.1f} Nm of {p.max_torque} Nm): holding until reset"
+        )
+        if self._move_active:
+            self._end_move(-1, END_FT_VIOLATION, False, self._latch_message)

@@ -1,0 +1,154 @@
+"""The per-axis contact laws (GCCF, with the thesis fork's refinements as named parameters).
+
+F is the force [N] (torque [Nm] on rotational axes) along the axis in the control frame, d the travel since
+the law was set [m] ([rad]), V the commanded velocity [m/s] ([rad/s]):
+
+- follower: V = F / b when |F| > deadband, else 0 (the rate limit then decelerates smoothly).
+- spring: V = scale * round(round(F) / b - k (d + d_offset)), rounding to `spring_rounding`.
+  k is in 1/s here (GCCF's form), the equivalent impedance stiffness is b * k [N/m].
+- compliant move: V = V_desired + F / b (no force term when b = 0); within `slowdown` of the max travel the
+  speed falls linearly with the remaining travel, never below `approach_speed`.
+- none: V = 0.
+
+`shape_velocity` then zeroes |V| <= min_velocity, clamps to the max velocity and limits acceleration and
+deceleration; a reversal of direction stops at once and then accelerates the other way.
+`check_end` gives GCCF's per-axis end conditions; `ForceWindow` the force-jump one.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+
+from contact_control.axes import (
+    END_FT_VIOLATION,
+    END_MAX_TRAVEL,
+    END_NONE,
+    LAW_COMPLIANT_MOVE,
+    LAW_FOLLOWER,
+    LAW_NONE,
+    LAW_SPRING,
+)
+from contact_control.params import AxisTuning
+
+__all__ = ["AxisLaw", "ForceWindow", "check_end", "law_velocity", "round_to", "shape_velocity"]
+
+
+@dataclass(frozen=True)
+class AxisLaw:
+    """The law of one axis and its parameters (units per axis kind: N or Nm, m or rad, s).
+
+    Attributes:
+        law: LAW_NONE, LAW_FOLLOWER, LAW_SPRING or LAW_COMPLIANT_MOVE.
+        damping: b [N/(m/s)] or [Nm/(rad/s)]; > 0 for follower and spring, >= 0 for compliant move.
+        stiffness: k [1/s] of the spring law.
+        velocity: V_desired of the compliant move [m/s] or [rad/s]; its sign is the direction.
+        force_limit: |F| at or above this ends the move (FT_VIOLATION); 0: no limit.
+        max_travel: |d| at or above this ends the move (MAX_TRAVEL); 0: no limit.
+        offset: d_offset of the spring law [m] or [rad].
+    """
+
+    law: int = LAW_NONE
+    damping: float = 0.0
+    stiffness: float = 0.0
+    velocity: float = 0.0
+    force_limit: float = 0.0
+    max_travel: float = 0.0
+    offset: float = 0.0
+
+
+def round_to(value: float, step: float) -> float:
+    """`value` rounded to a multiple of `step` (unchanged when step is 0)."""
+    return round(value / step) * step if step else value
+
+
+def law_velocity(law: AxisLaw, tuning: AxisTuning, force: float, travel: float) -> float:
+    """The law's velocity before shaping."""
+    kind = law.law
+    if kind == LAW_FOLLOWER:
+        if -tuning.deadband <= force <= tuning.deadband:
+            return 0.0
+        return force / law.damping
+    if kind == LAW_SPRING:
+        step = tuning.spring_rounding
+        v = round_to(force, step) / law.damping - law.stiffness * (travel + law.offset)
+        return tuning.spring_scale * round_to(v, step)
+    if kind == LAW_COMPLIANT_MOVE:
+        speed = abs(law.velocity)
+        if law.max_travel > 0.0 and tuning.slowdown > 0.0:
+            remaining = law.max_travel - abs(travel)
+            if remaining < tuning.slowdown:
+                speed = max(min(speed, tuning.approach_speed), speed * remaining / tuning.slowdown)
+        v = math.copysign(speed, law.velocity)
+        if law.damping > 0.0:
+            v += force / law.damping
+        return v
+    return 0.0
+
+
+def shape_velocity(target: float, previous: float, tuning: AxisTuning, dt: float) -> float:
+    """Applies min velocity, the velocity clamp and the acceleration/deceleration limits.
+
+    Args:
+        target: the law's velocity.
+        previous: the velocity commanded last cycle.
+        tuning: limits of this axis kind.
+        dt: time since the last cycle [s].
+    """
+    if -tuning.min_velocity <= target <= tuning.min_velocity:
+        target = 0.0
+    elif target > tuning.max_velocity:
+        target = tuning.max_velocity
+    elif target < -tuning.max_velocity:
+        target = -tuning.max_velocity
+    if target * previous < 0.0:
+        # Reversal (pushed the other way): stop at once rather than keep moving against the push.
+        previous = 0.0
+    if (previous >= 0.0 and target > previous) or (previous <= 0.0 and target < previous):
+        step = tuning.acceleration * dt  # speeding up (from rest or in the same direction)
+    else:
+        step = tuning.deceleration * dt
+    if target > previous + step:
+        return previous + step
+    if target < previous - step:
+        return previous - step
+    return target
+
+
+def check_end(law: AxisLaw, force: float, travel: float) -> int:
+    """END_FT_VIOLATION, END_MAX_TRAVEL or END_NONE for this axis (force first, as GCCF)."""
+    if law.force_limit > 0.0 and abs(force) >= law.force_limit:
+        return END_FT_VIOLATION
+    if law.max_travel > 0.0 and abs(travel) >= law.max_travel:
+        return END_MAX_TRAVEL
+    return END_NONE
+
+
+class ForceWindow:
+    """Spread (max - min) of a force over the last `window` seconds, amortised O(1) per sample."""
+
+    def __init__(self, window: float) -> None:
+        self.window = window
+        self._max: deque[tuple[float, float]] = deque()
+        self._min: deque[tuple[float, float]] = deque()
+
+    def clear(self) -> None:
+        self._max.clear()
+        self._min.clear()
+
+    def add(self, t: float, force: float) -> float:
+        """Adds a sample at time `t` [s] and returns the spread over (t - window, t]."""
+        hi, lo = self._max, self._min
+        while hi and hi[-1][1] <= force:
+            hi.pop()
+        hi.append((t, force))
+        while lo and lo[-1][1] >= force:
+            lo.pop()
+        lo.append((t, force))
+        oldest = t - self.window
+        while hi[0][0] < oldest:
+            hi.popleft()
+        while lo[0][0] < oldest:
+            lo.popleft()
+        return hi[0][1] - lo[0][1]

@@ -1,0 +1,287 @@
+"""contact_control_node: the rospy adapter around `ContactControl` (see the package README).
+
+Per wrench: look up the transforms (static ones are cached, each frame at most once per cycle), run one
+`ContactControl.update` and publish the twist at once (lowest latency). A timer at ~control_rate detects stale
+wrenches and keeps publishing zero while a move waits for data. Twists are published while a move is active,
+then `idle_zero_count` zeros after it ends, then nothing, so other sources (keyboard jogging) can use the same
+topic in between.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import sys
+import threading
+from collections.abc import Sequence
+from typing import Any
+
+import rospy
+import tf2_ros
+from cartesian_impedance_msgs.msg import CartesianForceCtrlErrorCodes
+from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlResponse
+from compliant_control_msgs.msg import AxisState, ContactControlStatus
+from geometry_msgs.msg import TwistStamped, WrenchStamped
+from std_srvs.srv import Trigger, TriggerResponse
+
+from contact_control.axes import AXES, SAFETY_NO_TF
+from contact_control.controller import ContactControl, CycleResult
+from contact_control.frames import (
+    IDENTITY,
+    compose,
+    inverse,
+    rotate_twist,
+    rotation,
+    transform,
+    transpose_times,
+)
+from contact_control.params import PARAMETERS, ContactControlSettings, ParamError, load_settings
+from contact_control.preprocess import PreprocessError
+from contact_control.request import RequestError, RequestLimits, validate_request
+
+__all__ = ["ContactControlNode", "main"]
+
+_ZERO = (0.0,) * 6
+_TF_ERRORS = (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException)
+
+
+class ContactControlNode:
+    """Topics, services, tf and timers around one `ContactControl`; every call into it holds `_lock`."""
+
+    def __init__(self, settings: ContactControlSettings) -> None:
+        s = self._s = settings
+        self._ctrl = ContactControl(settings)
+        self._limits = RequestLimits.from_settings(settings)
+        self._lock = threading.Lock()
+        self._move_ended = threading.Condition(self._lock)
+        self._buffer = tf2_ros.Buffer()
+        self._listener = tf2_ros.TransformListener(self._buffer)
+        self._static: dict[str, list[list[float]]] = {s.fixed_frame: IDENTITY}
+        self._time0 = rospy.Time(0)
+        self._gravity = s.tool_mass > 0.0
+        self._idle_zeros = 0
+        self._was_active = False
+        self._request_note = ""
+        self._twist = TwistStamped()
+        self._twist.header.frame_id = s.velocity_command_frame
+        self._twist_pub = rospy.Publisher(s.velocity_out_topic, TwistStamped, queue_size=1, tcp_nodelay=True)
+        self._status_pub = rospy.Publisher("~status", ContactControlStatus, queue_size=10)
+        # Service names in the node's namespace (not private), as the original served them.
+        self._services = [
+            rospy.Service("configure_cartesian_impedance", ConfigureForceControl, self._on_configure),
+            rospy.Service(
+                "configure_cartesian_impedance_blocking", ConfigureForceControl, self._on_configure_blocking
+            ),
+            rospy.Service("~tare", Trigger, self._on_tare),
+            rospy.Service("~stop", Trigger, self._on_stop),
+            rospy.Service("~reset", Trigger, self._on_reset),
+        ]
+        self._sub = rospy.Subscriber(
+            s.ft_in_topic, WrenchStamped, self._on_wrench, queue_size=1, tcp_nodelay=True
+        )
+        self._timer = rospy.Timer(rospy.Duration(1.0 / s.control_rate), self._on_timer)
+        self._status_timer = rospy.Timer(rospy.Duration(1.0 / s.status_rate), self._on_status)
+        rospy.on_shutdown(self._on_shutdown)
+
+    # --- tf ---
+    def _lookup(self, frame: str) -> list[list[float]]:
+        """The pose of `frame` in the fixed frame (4x4 rows); cached when the chain is static."""
+        cached = self._static.get(frame)
+        if cached is not None:
+            return cached
+        msg = self._buffer.lookup_transform(self._s.fixed_frame, frame, self._time0)
+        t, q = msg.transform.translation, msg.transform.rotation
+        pose = transform((t.x, t.y, t.z), (q.x, q.y, q.z, q.w))
+        if msg.header.stamp.is_zero():  # tf2 answers time 0 only when every link of the chain is static
+            self._static[frame] = pose
+        return pose
+
+    def _frames(self, sensor_frame: str, need_eef: bool) -> tuple[Any, Any, Any, Any, Any]:
+        """(T_control_sensor, R_world_sensor, T_fixed_eef, R_fixed_control, R_command_control) for one cycle.
+
+        Each frame is looked up at most once; None stands for "same frame" or "not needed".
+        """
+        s = self._s
+        poses: dict[str, list[list[float]]] = {}
+
+        def pose(frame: str) -> list[list[float]]:
+            if frame not in poses:
+                poses[frame] = self._lookup(frame)
+            return poses[frame]
+
+        T_fixed_control = pose(s.control_frame)
+        R_fixed_control = None if s.control_frame == s.fixed_frame else rotation(T_fixed_control)
+        T_control_sensor = None
+        if sensor_frame != s.control_frame:
+            T_fixed_sensor = pose(sensor_frame)
+            if R_fixed_control is None:
+                T_control_sensor = T_fixed_sensor
+            else:
+                T_control_sensor = compose(inverse(T_fixed_control), T_fixed_sensor)
+        R_world_sensor = rotation(pose(sensor_frame)) if self._gravity else None
+        eef = pose(s.eef_frame) if need_eef else None
+        R_command_control = None
+        if s.velocity_command_frame != s.control_frame:
+            R_fixed_command = rotation(pose(s.velocity_command_frame))
+            R_command_control = transpose_times(R_fixed_command, rotation(T_fixed_control))
+        return T_control_sensor, R_world_sensor, eef, R_fixed_control, R_command_control
+
+    # --- cycles ---
+    def _on_wrench(self, msg: WrenchStamped) -> None:
+        t = rospy.get_time()
+        f, q = msg.wrench.force, msg.wrench.torque
+        wrench = (f.x, f.y, f.z, q.x, q.y, q.z)
+        stamp = msg.header.stamp.to_sec() if not msg.header.stamp.is_zero() else None
+        sensor_frame = msg.header.frame_id or self._s.ft_sensor_frame
+        with self._lock:
+            try:
+                T_cs, R_ws, eef, R_fc, R_cc = self._frames(sensor_frame, self._ctrl.needs_travel)
+            except _TF_ERRORS as err:
+                self._publish(self._ctrl.hold(t, SAFETY_NO_TF, f"no transform: {err}"))
+            else:
+                self._publish(self._ctrl.update(wrench, t, T_cs, R_ws, eef, R_fc, stamp), R_cc)
+
+    def _on_timer(self, _event: Any) -> None:
+        with self._lock:
+            result = self._ctrl.check_stale(rospy.get_time())
+            if result is not None:
+                self._publish(result)
+
+    def _publish(self, result: CycleResult, R_command_control: Any = None) -> None:
+        """Twist out according to the publish policy; wakes blocking callers when a move ends."""
+        if result.move_active:
+            self._idle_zeros = int(self._s.idle_zero_count)
+            v = result.velocity
+            self._send(v if R_command_control is None or not any(v) else rotate_twist(R_command_control, v))
+        elif self._was_active:
+            self._move_ended.notify_all()
+            self._send(_ZERO)  # at least one zero right away, whatever idle_zero_count says
+        elif self._idle_zeros > 0:
+            self._idle_zeros -= 1
+            self._send(_ZERO)
+        elif self._s.publish_when_idle:
+            self._send(_ZERO)
+        self._was_active = result.move_active
+
+    def _send(self, velocity: Sequence[float]) -> None:
+        """Publishes a twist already expressed in velocity_command_frame."""
+        tw = self._twist
+        tw.header.stamp = rospy.Time.now()
+        lin, ang = tw.twist.linear, tw.twist.angular
+        lin.x, lin.y, lin.z, ang.x, ang.y, ang.z = velocity
+        self._twist_pub.publish(tw)
+
+    # --- services ---
+    def _configure(self, req: Any) -> int | None:
+        """Validates and applies a request (lock held); the new move id, or None when refused."""
+        try:
+            laws = validate_request(req, self._limits)
+            move_id = self._ctrl.set_laws(laws, None, rospy.get_time())
+        except RequestError as err:
+            self._request_note = f"last request refused (code {err.code}): {err.message}"
+            rospy.logwarn("configure_cartesian_impedance refused (error code %d): %s", err.code, err.message)
+            return None
+        self._request_note = ""
+        self._idle_zeros = int(self._s.idle_zero_count)
+        self._move_ended.notify_all()  # a blocking caller of a replaced move answers now
+        active = ", ".join(f"{AXES[i]}={law.law}" for i, law in enumerate(laws) if law.law)
+        rospy.loginfo("contact laws set (move %d): %s", move_id, active or "none (all axes still)")
+        return move_id
+
+    @staticmethod
+    def _response(success: bool) -> ConfigureForceControlResponse:
+        # CartesianForceCtrlErrorCodes has constants only, no field: the code goes to the log and ~status.
+        return ConfigureForceControlResponse(success=success, error=CartesianForceCtrlErrorCodes())
+
+    def _on_configure(self, req: Any) -> ConfigureForceControlResponse:
+        with self._lock:
+            return self._response(self._configure(req) is not None)
+
+    def _on_configure_blocking(self, req: Any) -> ConfigureForceControlResponse:
+        with self._lock:
+            move_id = self._configure(req)
+            if move_id is None:
+                return self._response(False)
+            while True:
+                outcome = self._ctrl.move_outcome(move_id)
+                if outcome is not None:
+                    return self._response(outcome)
+                if rospy.is_shutdown():
+                    return self._response(False)
+                self._move_ended.wait(0.1)
+
+    def _on_tare(self, _req: Any) -> TriggerResponse:
+        with self._lock:
+            try:
+                bias = self._ctrl.tare()
+            except PreprocessError as err:
+                return TriggerResponse(success=False, message=str(err))
+        return TriggerResponse(success=True, message="bias [N, Nm]: " + ", ".join(f"{b:.4g}" for b in bias))
+
+    def _on_stop(self, _req: Any) -> TriggerResponse:
+        with self._lock:
+            stopped = self._ctrl.stop("stop service")
+            if stopped:
+                self._move_ended.notify_all()
+                self._was_active = False
+                self._idle_zeros = int(self._s.idle_zero_count)
+                self._send(_ZERO)
+        return TriggerResponse(success=True, message="move stopped" if stopped else "no move was running")
+
+    def _on_reset(self, _req: Any) -> TriggerResponse:
+        with self._lock:
+            was = self._ctrl.reset_safety()
+        message = "safety latch cleared" if was else "safety was not latched"
+        return TriggerResponse(success=True, message=message)
+
+    # --- status ---
+    def _on_status(self, _event: Any) -> None:
+        with self._lock:
+            r = self._ctrl.last_result
+            note = self._request_note
+        msg = ContactControlStatus()
+        msg.header.stamp = rospy.Time.now()
+        msg.header.frame_id = self._s.control_frame
+        msg.move_active = r.move_active
+        msg.safety = r.safety
+        msg.message = "; ".join(m for m in (r.message, note) if m)
+        w, v = r.wrench, r.velocity
+        f, q = msg.wrench.force, msg.wrench.torque
+        f.x, f.y, f.z, q.x, q.y, q.z = w
+        lin, ang = msg.velocity.linear, msg.velocity.angular
+        lin.x, lin.y, lin.z, ang.x, ang.y, ang.z = v
+        msg.axes = [
+            AxisState(
+                axis=AXES[i], law=r.laws[i], end_condition=r.end_conditions[i], force=w[i], velocity=v[i],
+                travel=r.travel[i],
+            )
+            for i in range(6)
+        ]
+        self._status_pub.publish(msg)
+
+    def _on_shutdown(self) -> None:
+        with self._lock:
+            if self._ctrl.stop("shutdown"):
+                self._move_ended.notify_all()
+                with contextlib.suppress(rospy.ROSException):  # the publisher may already be closing
+                    self._send(_ZERO)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of `rosrun contact_control contact_control_node`."""
+    rospy.init_node("contact_control_node", argv=list(sys.argv if argv is None else argv))
+    try:
+        settings = load_settings(rospy.get_param("~", {}))
+    except ParamError as err:
+        rospy.logfatal("contact_control_node: bad configuration, not starting: %s", err)
+        return 1
+    if settings.unknown_keys:
+        rospy.logwarn("contact_control_node: ignoring unknown parameters %s (known: see the README)",
+                      ", ".join(settings.unknown_keys))
+    ContactControlNode(settings)
+    rospy.loginfo(
+        "contact_control_node: wrench in %s, twist out %s (%s), control frame %s, %d parameters loaded",
+        rospy.resolve_name(settings.ft_in_topic), rospy.resolve_name(settings.velocity_out_topic),
+        settings.velocity_command_frame, settings.control_frame, len(PARAMETERS),
+    )
+    rospy.spin()
+    return 0

@@ -1,0 +1,190 @@
+"""Wrench preprocessing (the original's netft_utils role): sign flips, bias, tool gravity, limits, filter,
+frame change and deadband, in that order.
+
+Convention: the result is the external wrench acting on the end effector, as a human pushing it feels it
+(push the tool along +Z and F_z > 0), in the control frame, torque about the control frame origin.
+The sensor is assumed to read the tool's weight as m * g (g = `gravity` in the fixed frame) plus the external
+wrench plus a constant offset. Rotations and transforms are row-major nested sequences or numpy arrays:
+`R_world_sensor` maps sensor-frame vectors into the fixed frame, `T_control_sensor` (4x4) maps sensor-frame
+points into the control frame. Plain floats throughout: for 6-vectors they beat numpy by a wide margin.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+from contact_control.axes import SAFETY_NAN, SAFETY_OK, SAFETY_OVER_LIMIT
+from contact_control.filters import LowPass
+from contact_control.params import ContactControlSettings
+
+__all__ = ["PreprocessError", "WrenchPreprocessor", "as_rows", "is_finite6"]
+
+
+class PreprocessError(ValueError):
+    """Bad input to a preprocessing request (tare with invalid data, missing orientation)."""
+
+
+def as_rows(matrix: Any) -> Sequence[Sequence[float]]:
+    """Nested rows of a matrix; numpy arrays are converted once (indexing them per element is slow)."""
+    return matrix.tolist() if hasattr(matrix, "tolist") else matrix
+
+
+def is_finite6(w: Sequence[float]) -> bool:
+    """True when all six numbers are finite (one sum: NaN and inf both poison it)."""
+    s = w[0] + w[1] + w[2] + w[3] + w[4] + w[5]
+    return s - s == 0.0
+
+
+class WrenchPreprocessor:
+    """Turns raw sensor wrenches into control-frame wrenches; holds bias and filter state."""
+
+    def __init__(self, settings: ContactControlSettings) -> None:
+        self._signs = settings.ft_directions
+        self._flip = self._signs != (1, 1, 1)
+        self._bias = [float(b) for b in settings.bias]
+        self._mass = settings.tool_mass
+        self._mg = [settings.tool_mass * g for g in settings.gravity]
+        self._com = tuple(settings.tool_com)
+        self.set_limits(settings.global_max_force, settings.global_max_torque)
+        self.set_deadband(settings.force_deadband, settings.torque_deadband)
+        self._filter: LowPass | None = None
+        if settings.lp_filter_enabled:
+            self.set_filter(True, settings.lp_filter_delta_t, settings.lp_filter_cutoff_freq)
+
+    # --- configuration (netft_utils-style setters) ---
+    @property
+    def bias(self) -> tuple[float, ...]:
+        """Current offset subtracted from the (sign-flipped) sensor wrench, net of tool gravity at tare."""
+        return tuple(self._bias)
+
+    def set_bias(self, bias: Sequence[float]) -> None:
+        """Sets the offset directly (sensor frame, after sign flips)."""
+        if len(bias) != 6 or not is_finite6(bias):
+            raise PreprocessError(f"bias must be 6 finite numbers, got {bias!r}")
+        self._bias = [float(b) for b in bias]
+        if self._filter:
+            self._filter.reset()
+
+    def set_limits(self, max_force: float, max_torque: float) -> None:
+        """Global limits on |force| [N] and |torque| [Nm] of the compensated sensor wrench."""
+        if not (max_force > 0.0 and max_torque > 0.0 and math.isfinite(max_force + max_torque)):
+            raise PreprocessError(f"limits must be finite and > 0, got {max_force}, {max_torque}")
+        self.max_force, self.max_torque = max_force, max_torque
+        self._fmax2, self._tmax2 = max_force * max_force, max_torque * max_torque
+
+    def set_deadband(self, force: float, torque: float) -> None:
+        """Components below these magnitudes [N], [Nm] read as zero (control frame)."""
+        if not (force >= 0.0 and torque >= 0.0 and math.isfinite(force + torque)):
+            raise PreprocessError(f"deadbands must be finite and >= 0, got {force}, {torque}")
+        self._db_force, self._db_torque = force, torque
+        self._deadband = force > 0.0 or torque > 0.0
+
+    def set_filter(self, enabled: bool, delta_t: float = 0.2, cutoff_freq: float = 0.6) -> None:
+        """Switches the low-pass filter (see `filters`); a new filter starts from the next sample."""
+        if not enabled:
+            self._filter = None
+            return
+        try:
+            self._filter = LowPass(delta_t, cutoff_freq, 6)
+        except ValueError as err:
+            raise PreprocessError(str(err)) from err
+
+    # --- tool gravity and tare ---
+    def gravity_wrench(self, R_world_sensor: Any) -> list[float]:
+        """The tool's weight as the sensor reads it at this orientation (sensor frame, about its origin)."""
+        if not self._mass:
+            return [0.0] * 6
+        if R_world_sensor is None:
+            raise PreprocessError("tool_mass is set, so the sensor orientation R_world_sensor is needed")
+        r = as_rows(R_world_sensor)
+        gx, gy, gz = self._mg
+        # R^T (m g): gravity expressed in the sensor frame.
+        fx = r[0][0] * gx + r[1][0] * gy + r[2][0] * gz
+        fy = r[0][1] * gx + r[1][1] * gy + r[2][1] * gz
+        fz = r[0][2] * gx + r[1][2] * gy + r[2][2] * gz
+        cx, cy, cz = self._com
+        return [fx, fy, fz, cy * fz - cz * fy, cz * fx - cx * fz, cx * fy - cy * fx]
+
+    def _flipped(self, raw: Sequence[float]) -> list[float]:
+        w = [float(v) for v in raw]
+        if self._flip:
+            for i in range(3):
+                w[i] *= self._signs[i]
+                w[i + 3] *= self._signs[i]
+        return w
+
+    def tare(self, raw: Sequence[float], R_world_sensor: Any = None) -> tuple[float, ...]:
+        """Makes the current reading the zero: stores the bias net of the tool's expected weight here.
+
+        After tare the compensated wrench is zero at this orientation and stays near zero when the sensor
+        is reoriented without contact, because only the constant offset was absorbed into the bias.
+
+        Raises:
+            PreprocessError: the reading is not finite or the orientation is missing while tool_mass > 0.
+        """
+        if len(raw) != 6 or not is_finite6(raw):
+            raise PreprocessError(f"cannot tare with an invalid wrench {raw!r}")
+        expected = self.gravity_wrench(R_world_sensor)
+        w = self._flipped(raw)
+        self._bias = [w[i] - expected[i] for i in range(6)]
+        if self._filter:
+            self._filter.reset()
+        return tuple(self._bias)
+
+    # --- the cycle ---
+    def process(
+        self, raw: Sequence[float], T_control_sensor: Any = None, R_world_sensor: Any = None
+    ) -> tuple[int, list[float] | None]:
+        """One sample through the chain.
+
+        Args:
+            raw: sensor wrench (fx, fy, fz, tx, ty, tz) [N, Nm] in the sensor frame.
+            T_control_sensor: 4x4 sensor pose in the control frame; None when they coincide.
+            R_world_sensor: 3x3 sensor orientation in the fixed frame; needed when tool_mass > 0.
+
+        Returns:
+            (SAFETY_OK, control-frame wrench), (SAFETY_NAN, None) for NaN/inf input, or
+            (SAFETY_OVER_LIMIT, compensated sensor-frame wrench) when a global limit is exceeded.
+            Neither failure touches the filter state.
+        """
+        fx, fy, fz, tx, ty, tz = raw
+        s = fx + fy + fz + tx + ty + tz
+        if s - s != 0.0:
+            return SAFETY_NAN, None
+        if self._flip:
+            sx, sy, sz = self._signs
+            fx, fy, fz, tx, ty, tz = fx * sx, fy * sy, fz * sz, tx * sx, ty * sy, tz * sz
+        b = self._bias
+        fx, fy, fz, tx, ty, tz = fx - b[0], fy - b[1], fz - b[2], tx - b[3], ty - b[4], tz - b[5]
+        if self._mass:
+            g = self.gravity_wrench(R_world_sensor)
+            fx, fy, fz, tx, ty, tz = fx - g[0], fy - g[1], fz - g[2], tx - g[3], ty - g[4], tz - g[5]
+        if fx * fx + fy * fy + fz * fz > self._fmax2 or tx * tx + ty * ty + tz * tz > self._tmax2:
+            return SAFETY_OVER_LIMIT, [fx, fy, fz, tx, ty, tz]
+        if self._filter is not None:
+            fx, fy, fz, tx, ty, tz = self._filter.step((fx, fy, fz, tx, ty, tz))
+        if T_control_sensor is not None:
+            m = as_rows(T_control_sensor)
+            r0, r1, r2 = m[0], m[1], m[2]
+            px, py, pz = r0[3], r1[3], r2[3]
+            cfx = r0[0] * fx + r0[1] * fy + r0[2] * fz
+            cfy = r1[0] * fx + r1[1] * fy + r1[2] * fz
+            cfz = r2[0] * fx + r2[1] * fy + r2[2] * fz
+            # Torque about the control origin: rotated sensor torque plus lever arm p x F.
+            tx, ty, tz = (
+                r0[0] * tx + r0[1] * ty + r0[2] * tz + py * cfz - pz * cfy,
+                r1[0] * tx + r1[1] * ty + r1[2] * tz + pz * cfx - px * cfz,
+                r2[0] * tx + r2[1] * ty + r2[2] * tz + px * cfy - py * cfx,
+            )
+            fx, fy, fz = cfx, cfy, cfz
+        out = [fx, fy, fz, tx, ty, tz]
+        if self._deadband:
+            dbf, dbt = self._db_force, self._db_torque
+            for i in range(3):
+                if -dbf < out[i] < dbf:
+                    out[i] = 0.0
+                if -dbt < out[i + 3] < dbt:
+                    out[i + 3] = 0.0
+        return SAFETY_OK, out
