@@ -1,0 +1,175 @@
+"""Serial-arm kinematics from a URDF string with Pinocchio: EEF pose and Jacobian of the controlled joints.
+
+Joints that are not controlled (grippers, a mobile base, ...) are locked at their neutral position with
+``pinocchio.buildReducedModel``, so the Jacobian has exactly one column per controlled joint. The model
+and its data are built once; every query reuses them.
+
+Frames: Jacobians are ``LOCAL_WORLD_ALIGNED`` at the tip frame, i.e. the velocity of the tip's origin and
+the angular velocity, both with the axes of the model's root (``universe``) frame.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import pinocchio as pin
+
+from jog_arm.settings import JointLimitOverride
+
+__all__ = ["ArmModel", "KinematicsError"]
+
+
+class KinematicsError(ValueError):
+    """The URDF cannot be parsed, or a frame or joint named in the configuration is not in it."""
+
+
+class ArmModel:
+    """Kinematic model of the controlled chain of a robot description.
+
+    Args:
+        urdf_xml: The URDF as a string (the `robot_description` parameter).
+        tip_frame: Frame whose motion is commanded (a link or fixed-joint frame of the URDF).
+        joint_names: Controlled joints in the order the caller uses; empty = every joint from the root to
+            `tip_frame`. The model's own order is the kinematic order; arrays in this class use it.
+        joint_limits: Per-joint overrides of the URDF limits.
+        default_max_acceleration: Acceleration limit [rad/s²] of joints without an override.
+
+    Raises:
+        KinematicsError: Unparsable URDF, unknown frame or joint, or a joint that is not a 1-DoF joint.
+    """
+
+    def __init__(
+        self,
+        urdf_xml: str,
+        tip_frame: str,
+        joint_names: Sequence[str] = (),
+        joint_limits: Mapping[str, JointLimitOverride] | None = None,
+        default_max_acceleration: float = 3.0,
+    ) -> None:
+        try:
+            full = pin.buildModelFromXML(urdf_xml)
+        except (RuntimeError, ValueError) as err:
+            raise KinematicsError(f"robot_description: cannot parse the URDF: {err}") from err
+        if not full.existFrame(tip_frame):
+            raise KinematicsError(
+                f"ee_frame_name {tip_frame!r} is not a frame of the URDF; frames: {_frame_names(full)}"
+            )
+        controlled = list(joint_names) or _chain_joints(full, tip_frame)
+        for name in controlled:
+            if not full.existJointName(name):
+                raise KinematicsError(f"joint_names: {name!r} is not a joint of the URDF")
+            joint = full.joints[full.getJointId(name)]
+            if joint.nq != 1 or joint.nv != 1:
+                raise KinematicsError(
+                    f"joint_names: {name!r} is not a 1-DoF revolute or prismatic joint (nq={joint.nq})"
+                )
+        locked = [jid for jid in range(1, full.njoints) if full.names[jid] not in controlled]
+        model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
+        self.model = model
+        self.data = model.createData()
+        self.nv = model.nv
+        # Kinematic order of the controlled joints: index i of every array in this class.
+        self.joint_names: tuple[str, ...] = tuple(model.names[1:])
+        self.tip_frame = tip_frame
+        self.tip_id = model.getFrameId(tip_frame)
+        self._tip_support = set(model.supports[model.frames[self.tip_id].parentJoint])
+
+        lower = model.lowerPositionLimit.copy()
+        upper = model.upperPositionLimit.copy()
+        velocity = model.velocityLimit.copy()
+        acceleration = np.full(self.nv, float(default_max_acceleration))
+        overrides = dict(joint_limits or {})
+        for name, override in overrides.items():
+            if name not in self.joint_names:
+                raise KinematicsError(f"joint_limits/{name}: not a controlled joint {list(self.joint_names)}")
+            i = self.joint_names.index(name)
+            if override.min_position is not None:
+                lower[i] = override.min_position
+            if override.max_position is not None:
+                upper[i] = override.max_position
+            if override.max_velocity is not None:
+                velocity[i] = override.max_velocity
+            if override.max_acceleration is not None:
+                acceleration[i] = override.max_acceleration
+        for i, name in enumerate(self.joint_names):
+            if not velocity[i] > 0.0 or not np.isfinite(velocity[i]):
+                raise KinematicsError(
+                    f"joint {name!r} has no velocity limit in the URDF: set joint_limits/{name}/max_velocity"
+                )
+            if not lower[i] < upper[i]:
+                raise KinematicsError(f"joint {name!r} has no position range ({lower[i]} >= {upper[i]})")
+        self.lower = lower
+        self.upper = upper
+        self.max_velocity = velocity
+        self.max_acceleration = acceleration
+
+        J = self.jacobian(self.neutral())
+        if not np.any(J):
+            raise KinematicsError(
+                f"ee_frame_name {tip_frame!r} is not moved by joints {list(self.joint_names)}"
+            )
+
+    # --- queries -------------------------------------------------------------------------------------
+
+    def neutral(self) -> np.ndarray:
+        """Neutral (all zero) configuration of the controlled joints, a fresh array."""
+        return pin.neutral(self.model)
+
+    def has_frame(self, name: str) -> bool:
+        """True if `name` is a frame (link or joint) of the model."""
+        return bool(name) and self.model.existFrame(name)
+
+    def frame_id(self, name: str) -> int:
+        """Pinocchio id of frame `name`.
+
+        Raises:
+            KinematicsError: Unknown frame.
+        """
+        if not self.has_frame(name):
+            raise KinematicsError(f"{name!r} is not a frame of the robot model")
+        return self.model.getFrameId(name)
+
+    def moves_with_tip_chain(self, frame_id: int) -> bool:
+        """True if the frame's placement is refreshed by :meth:`jacobian` (root or on the tip's chain)."""
+        return self.model.frames[frame_id].parentJoint in self._tip_support
+
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        """Tip Jacobian (6 x nv, linear rows first, LOCAL_WORLD_ALIGNED) at `q`.
+
+        Also refreshes the placements of the joints on the tip's chain and of the tip frame in `self.data`.
+        """
+        return pin.computeFrameJacobian(self.model, self.data, q, self.tip_id, pin.LOCAL_WORLD_ALIGNED)
+
+    def frame_rotation(self, frame_id: int, q: np.ndarray | None = None) -> np.ndarray:
+        """Rotation of a frame in the root frame, after :meth:`jacobian` (or at `q` if given).
+
+        Frames off the tip's chain need `q` (a full forward kinematics), unless fixed to the root.
+        """
+        if q is not None:
+            pin.forwardKinematics(self.model, self.data, q)
+        return pin.updateFramePlacement(self.model, self.data, frame_id).rotation
+
+    def frame_pose(self, q: np.ndarray, frame: str, relative_to: str = "") -> pin.SE3:
+        """Pose of `frame` in `relative_to` (the root frame if empty) at configuration `q`.
+
+        Raises:
+            KinematicsError: Unknown frame.
+        """
+        fid = self.frame_id(frame)
+        pin.forwardKinematics(self.model, self.data, q)
+        pose = pin.updateFramePlacement(self.model, self.data, fid).copy()
+        if relative_to:
+            base = pin.updateFramePlacement(self.model, self.data, self.frame_id(relative_to))
+            pose = base.actInv(pose)
+        return pose
+
+
+def _chain_joints(model: pin.Model, tip_frame: str) -> list[str]:
+    """Names of the joints from the root to `tip_frame` (checked for 1 DoF by the caller)."""
+    parent = model.frames[model.getFrameId(tip_frame)].parentJoint
+    return [model.names[jid] for jid in model.supports[parent][1:]]
+
+
+def _frame_names(model: pin.Model) -> list[str]:
+    return [frame.name for frame in model.frames if frame.type == pin.FrameType.BODY]

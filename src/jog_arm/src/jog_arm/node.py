@@ -1,0 +1,269 @@
+"""jog_arm_server: the rospy adapter around :class:`jog_arm.JogCalcs` (see the package README).
+
+Callbacks only hand data to the library under a lock; a timer at ``pub_period`` runs one cycle and
+publishes the joint command (JointTrajectory or Float64MultiArray) and ``~status``. Frames a command names
+that the robot model lacks are looked up once in tf (relative to ``planning_frame``) and cached as fixed
+frames; frames tf does not have either are refused with a warning.
+"""
+
+from __future__ import annotations
+
+import gc
+import sys
+import threading
+from typing import Any
+
+import pinocchio as pin
+import rospy
+import tf2_ros
+from compliant_control_msgs.msg import JogStatus
+from geometry_msgs.msg import TwistStamped
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+from std_srvs.srv import Trigger, TriggerResponse
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+
+from jog_arm.jog_calcs import JogCalcs
+from jog_arm.kinematics import KinematicsError
+from jog_arm.settings import JogSettings, SettingsError
+from jog_arm.status import StatusCode
+from jog_arm.timing import CycleMonitor
+
+__all__ = ["JogArmNode", "main"]
+
+_TF_ERRORS = (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException)
+_WARN_PERIOD = 2.0  # [s] throttle of repeated warnings
+
+
+class JogArmNode:
+    """Topics, services, tf and the timer around one `JogCalcs`; every call into it holds `_lock`.
+
+    Args:
+        settings: Validated parameters.
+        urdf_xml: The robot description.
+
+    Raises:
+        KinematicsError, SettingsError: The configuration does not fit the robot model.
+    """
+
+    def __init__(self, settings: JogSettings, urdf_xml: str) -> None:
+        self._s = settings
+        self._jog = JogCalcs(settings, urdf_xml)
+        self._lock = threading.Lock()
+        self._tf_buffer = tf2_ros.Buffer()
+        self._tf_listener = tf2_ros.TransformListener(self._tf_buffer)
+        self._frames_ready: set[str] = set()  # command frames known to be usable (model, or tf looked up)
+        self._last_status = StatusCode.NO_JOINT_STATE
+        self._cycles = CycleMonitor(settings.pub_period)
+        names = list(self._jog.joint_names)
+        self._joint_set = frozenset(names)
+        self._points = settings.simu_points if settings.simu else 1
+        if settings.command_out_type == "trajectory":
+            self._cmd_msg: Any = JointTrajectory(joint_names=names)
+            self._cmd_pub = rospy.Publisher(
+                settings.cmd_out_topic, JointTrajectory, queue_size=1, tcp_nodelay=True
+            )
+        else:
+            self._cmd_msg = Float64MultiArray()
+            self._cmd_pub = rospy.Publisher(
+                settings.cmd_out_topic, Float64MultiArray, queue_size=1, tcp_nodelay=True
+            )
+        self._status_msg = JogStatus()
+        self._status_pub = rospy.Publisher("~status", JogStatus, queue_size=100)
+        self._services = [
+            rospy.Service("~pause", Trigger, self._on_pause),
+            rospy.Service("~resume", Trigger, self._on_resume),
+            rospy.Service("~cycle_stats", Trigger, self._on_cycle_stats),
+        ]
+        fast = {"queue_size": 1, "tcp_nodelay": True}
+        self._subs = [
+            rospy.Subscriber(settings.joint_topic, JointState, self._on_joints, **fast),
+            rospy.Subscriber(settings.cmd_in_topic, TwistStamped, self._on_twist, **fast),
+        ]
+        self._timer = rospy.Timer(rospy.Duration(settings.pub_period), self._on_timer)
+        rospy.loginfo(
+            "jog_arm_server: %d joints %s, tip %s, commands on %s (%s) -> %s on %s every %.4f s",
+            len(names),
+            names,
+            settings.ee_frame_name,
+            rospy.resolve_name(settings.cmd_in_topic),
+            settings.command_in_type,
+            settings.command_out_type,
+            rospy.resolve_name(settings.cmd_out_topic),
+            settings.pub_period,
+        )
+
+    # --- callbacks ----------------------------------------------------------------------------------------
+
+    def _on_joints(self, msg: JointState) -> None:
+        with self._lock:
+            ok = self._jog.set_joint_state_named(msg.name, msg.position)
+        if not ok and self._joint_set.intersection(msg.name):  # other robots' / grippers' states: ignore
+            rospy.logwarn_throttle(
+                _WARN_PERIOD,
+                "jog_arm_server: ignoring a joint state that lacks finite positions for "
+                f"{list(self._jog.joint_names)}",
+            )
+
+    def _on_twist(self, msg: TwistStamped) -> None:
+        now = rospy.get_time()
+        frame = msg.header.frame_id.lstrip("/")
+        self._ensure_frame(frame or self._s.default_cmd_frame)
+        lin, ang = msg.twist.linear, msg.twist.angular
+        twist = (lin.x, lin.y, lin.z, ang.x, ang.y, ang.z)
+        with self._lock:
+            result = self._jog.set_command(twist, frame, now)
+        if not result.accepted:
+            rospy.logwarn_throttle(_WARN_PERIOD, f"jog_arm_server: command refused: {result.reason}")
+
+    def _ensure_frame(self, frame: str) -> None:
+        """Makes a frame tf knows but the model does not usable (looked up once, then cached)."""
+        if frame in self._frames_ready:
+            return
+        with self._lock:
+            known = self._jog.has_frame(frame)
+        if known:
+            self._frames_ready.add(frame)
+            return
+        try:
+            tf = self._tf_buffer.lookup_transform(self._s.planning_frame, frame, rospy.Time(0))
+        except _TF_ERRORS as err:  # not cached: tf may still be filling up; try again next command
+            rospy.logwarn_throttle(
+                _WARN_PERIOD, f"jog_arm_server: frame {frame!r} is in neither the robot model nor tf: {err}"
+            )
+            return
+        q = tf.transform.rotation
+        rotation = pin.Quaternion(q.w, q.x, q.y, q.z).normalized().toRotationMatrix()
+        with self._lock:
+            self._jog.add_frame(frame, self._s.planning_frame, rotation)
+        self._frames_ready.add(frame)
+        rospy.loginfo(
+            "jog_arm_server: commands in %r use its tf rotation to %r, looked up once (assumed fixed)",
+            frame,
+            self._s.planning_frame,
+        )
+
+    def _on_timer(self, _event: rospy.timer.TimerEvent) -> None:
+        now = rospy.get_time()
+        if self._cycles.tick(now):
+            rospy.logwarn_throttle(
+                10.0,
+                f"jog_arm_server: {self._cycles.missed} publish cycles missed so far "
+                f"(longest gap {self._cycles.max_gap * 1e3:.1f} ms, period {self._s.pub_period * 1e3:g} ms)",
+            )
+        with self._lock:
+            out = self._jog.step(now)
+            publish = out.publish
+            if publish:
+                if self._points > 1:
+                    points = self._jog.trajectory_points(self._points)
+                else:
+                    points = [(out.positions, out.velocities, self._s.pub_period)]
+            status, message = out.status, out.message
+            condition, scale = out.condition_number, out.speed_scale
+        if publish:
+            self._publish_command(points)
+        if self._status_pub.get_num_connections() > 0:  # nobody listening: save the cycle the work
+            msg = self._status_msg
+            msg.header.stamp = rospy.Time.from_sec(now)
+            msg.code, msg.message, msg.condition_number, msg.speed_scale = (
+                int(status),
+                message,
+                condition,
+                scale,
+            )
+            self._status_pub.publish(msg)
+        if status != self._last_status:
+            self._log_status(status, message)
+            self._last_status = status
+
+    def _publish_command(self, points: list[tuple[tuple[float, ...], tuple[float, ...], float]]) -> None:
+        msg = self._cmd_msg
+        if isinstance(msg, Float64MultiArray):
+            msg.data = points[0][1]
+        else:
+            # Stamp 0: "start now" for joint_trajectory_controller, whatever the transport delay.
+            msg.points = [
+                JointTrajectoryPoint(positions=q, velocities=v, time_from_start=rospy.Duration.from_sec(t))
+                for q, v, t in points
+            ]
+        self._cmd_pub.publish(msg)
+
+    @staticmethod
+    def _log_status(status: StatusCode, message: str) -> None:
+        if status in (StatusCode.NO_WARNING, StatusCode.STALE_COMMAND, StatusCode.JOINT_VELOCITY_SCALED):
+            rospy.logdebug("jog_arm_server: %s: %s", status.name, message)
+        elif status in (StatusCode.PAUSED, StatusCode.NO_JOINT_STATE):
+            rospy.loginfo("jog_arm_server: %s: %s", status.name, message)
+        else:
+            rospy.logwarn("jog_arm_server: %s: %s", status.name, message)
+
+    def _on_pause(self, _req: Any) -> TriggerResponse:
+        with self._lock:
+            self._jog.pause()
+        return TriggerResponse(success=True, message="paused: stopping, commands ignored until ~resume")
+
+    def _on_resume(self, _req: Any) -> TriggerResponse:
+        with self._lock:
+            was_paused = self._jog.paused
+            self._jog.resume()
+        return TriggerResponse(
+            success=True, message="resumed: waiting for a new command" if was_paused else "was not paused"
+        )
+
+    def _on_cycle_stats(self, _req: Any) -> TriggerResponse:
+        """Cycle timing since the previous call (or start), then starts a new window."""
+        summary = self._cycles.summary()
+        self._cycles.reset()
+        return TriggerResponse(success=True, message=" ".join(f"{k}={v}" for k, v in summary.items()))
+
+    def shutdown(self) -> None:
+        """Stops the timer and unregisters topics and services."""
+        self._timer.shutdown()
+        for sub in self._subs:
+            sub.unregister()
+        for service in self._services:
+            service.shutdown()
+        self._cmd_pub.unregister()
+        self._status_pub.unregister()
+
+
+def load(params: dict[str, Any], urdf_xml: str | None, prefix: str) -> tuple[JogSettings, list[str]]:
+    """Validates the parameters and the presence of a robot description (no ROS calls).
+
+    Raises:
+        SettingsError: Naming the bad key, or the missing robot_description.
+    """
+    settings, warnings = JogSettings.from_params_with_warnings(params, prefix)
+    if not urdf_xml:
+        raise SettingsError("robot_description parameter is missing or empty: load the URDF first")
+    return settings, warnings
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Runs the node until shutdown. Returns 1, with a fatal log naming the key, if start-up is refused."""
+    rospy.init_node("jog_arm_server", argv=argv)
+    prefix = rospy.get_name() + "/"
+    try:
+        urdf = rospy.get_param("robot_description", None)
+        settings, warnings = load(rospy.get_param("~", {}), urdf, prefix)
+        for warning in warnings:
+            rospy.logwarn(warning)
+        node = JogArmNode(settings, urdf)
+    except (SettingsError, KinematicsError) as err:
+        rospy.logfatal(f"jog_arm_server refused to start: {err}")
+        return 1
+    # A thread waiting for the GIL waits up to the switch interval (5 ms by default) for a busy one (rospy's
+    # receive threads at 1 kHz) to let go: keep it well below the publish period so cycles start on time.
+    sys.setswitchinterval(min(sys.getswitchinterval(), settings.pub_period / 10.0))
+    # Start-up objects (Pinocchio model, rospy machinery) never die: keep them out of the collector's
+    # full passes, which would otherwise stall a cycle for milliseconds now and then.
+    gc.collect()
+    gc.freeze()
+    rospy.on_shutdown(node.shutdown)
+    rospy.spin()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,324 @@
+"""jog_arm_server end to end: a private master, replayed joint states, twists in, joint commands out."""
+
+from __future__ import annotations
+
+import contextlib
+import itertools
+import math
+import threading
+from collections.abc import Iterator
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from harness.bags import replay_bag, typestore, write_bag
+from harness.launch import run_launch, run_node
+from harness.waiting import Collector, wait_until
+from jog_arm_testing import PANDA, UR5, angle_deg
+
+from jog_arm import ArmModel, StatusCode
+
+JogStatus = pytest.importorskip("compliant_control_msgs.msg", reason="build the workspace first").JogStatus
+
+FINGERS = ("panda_finger_joint1", "panda_finger_joint2")
+
+
+def panda_joint_bag(path, seconds: float, rate: float = 100.0) -> None:
+    """A bag of a Panda standing still at the start pose, fingers included (as franka_ros publishes)."""
+    ts = typestore()
+    JointState = ts.types["sensor_msgs/msg/JointState"]
+    Header = ts.types["std_msgs/msg/Header"]
+    Time = ts.types["builtin_interfaces/msg/Time"]
+    names = [f"panda_joint{i}" for i in range(1, 8)] + list(FINGERS)
+    position = np.array([*PANDA.start, 0.02, 0.02])
+    entries = []
+    for k in range(int(seconds * rate)):
+        stamp = 1_000_000_000 + int(k * 1e9 / rate)
+        header = Header(seq=k, stamp=Time(sec=stamp // 10**9, nanosec=stamp % 10**9), frame_id="")
+        msg = JointState(
+            header=header, name=names, position=position, velocity=np.zeros(9), effort=np.zeros(9)
+        )
+        entries.append(("/jog_test/joint_states", "sensor_msgs/msg/JointState", stamp, msg))
+    write_bag(path, entries)
+
+
+def set_params(rospy, node: str, params: dict) -> None:
+    """Private parameters set on the master before the node starts (nested values included)."""
+    for key, value in params.items():
+        rospy.set_param(f"/{node}/{key}", value)
+
+
+def twist_msg(values: tuple[float, ...], frame: str = ""):
+    from geometry_msgs.msg import TwistStamped
+
+    msg = TwistStamped()
+    msg.header.frame_id = frame
+    (msg.twist.linear.x, msg.twist.linear.y, msg.twist.linear.z) = values[:3]
+    (msg.twist.angular.x, msg.twist.angular.y, msg.twist.angular.z) = values[3:]
+    return msg
+
+
+def panda_params(**extra) -> dict:
+    return {
+        "ee_frame_name": PANDA.tip,
+        "planning_frame": PANDA.planning_frame,
+        "command_in_type": "speed_units",
+        "pub_period": 0.01,
+        "incoming_cmd_timeout": 0.3,
+        "integrate_from": "measured",  # every output starts from the replayed state
+        "joint_topic": "/jog_test/joint_states",
+        "cmd_in_topic": "/jog_test/twist",
+        "cmd_out_topic": "/jog_test/command",
+        "num_outgoing_halt_msgs_to_publish": 5,
+        **PANDA.params,
+        **extra,
+    }
+
+
+class Sender:
+    """Publishes a twist at a steady rate from a thread until stopped (a teleop device)."""
+
+    def __init__(self, rospy, topic: str) -> None:
+        from geometry_msgs.msg import TwistStamped
+
+        self._rospy = rospy
+        self.pub = rospy.Publisher(topic, TwistStamped, queue_size=1, tcp_nodelay=True)
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+
+    def start(self, msg, rate: float = 50.0) -> None:
+        self.stop()
+        self._stop.clear()
+
+        def loop() -> None:
+            while not self._stop.is_set():
+                self.pub.publish(msg)
+                self._stop.wait(1.0 / rate)
+
+        self._thread = threading.Thread(target=loop, daemon=True)
+        self._thread.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
+            self._thread = None
+
+
+@contextlib.contextmanager
+def node_log_on_failure(node) -> Iterator[None]:
+    """Adds the node's output to a failing assertion (the node runs in another process)."""
+    try:
+        yield
+    except AssertionError as err:
+        raise AssertionError(f"{err}\n--- node output ---\n{node.output()[-4000:]}") from err
+
+
+def eef_velocity(model: ArmModel, q, dq) -> np.ndarray:
+    return model.jacobian(np.asarray(q, dtype=float)) @ np.asarray(dq, dtype=float)
+
+
+def test_replayed_state_twist_in_trajectory_out_then_stale_stop_and_refusals(ros_node, tmp_path) -> None:
+    from trajectory_msgs.msg import JointTrajectory
+
+    rospy = ros_node
+    bag = tmp_path / "panda_joint_states.bag"
+    panda_joint_bag(bag, seconds=12.0)
+    rospy.set_param("/robot_description", PANDA.urdf)
+    name = "jog_test_panda"
+    set_params(rospy, name, panda_params())
+    model = ArmModel(PANDA.urdf, PANDA.tip)
+
+    commands = Collector("/jog_test/command", JointTrajectory)
+    status = Collector(f"/{name}/status", JogStatus)
+    sender = Sender(rospy, "/jog_test/twist")
+    with run_node("jog_arm", "jog_arm_server", name=name) as node, node_log_on_failure(node):
+        node.wait_for_topic("/jog_test/command")
+        replay = threading.Thread(target=replay_bag, args=(bag,), daemon=True)
+        replay.start()
+        try:
+            wait_until(
+                lambda: status.msgs and status.msgs[-1].code == StatusCode.STALE_COMMAND, 20, "joint state"
+            )
+            assert not commands.msgs  # nothing is sent before the first command
+            wait_until(
+                lambda: sender.pub.get_num_connections() > 0, 10, "jog_arm_server subscribed to twists"
+            )
+
+            # A +x twist in the planning frame: the EEF velocity of each command points along +x.
+            sender.start(twist_msg((0.05, 0.0, 0.0, 0.0, 0.0, 0.0)))
+            commands.wait_for(30, timeout=10)
+            msg = commands.last()
+            assert list(msg.joint_names) == [f"panda_joint{i}" for i in range(1, 8)]
+            assert len(msg.points) == 1
+            point = msg.points[0]
+            assert point.time_from_start.to_sec() == pytest.approx(0.01)
+            twist = eef_velocity(model, PANDA.start, point.velocities)
+            assert angle_deg(twist[:3], np.array([1.0, 0.0, 0.0])) < 1.0
+            assert np.linalg.norm(twist[:3]) == pytest.approx(0.05, rel=0.02)  # filter settled, DC gain 1
+            assert np.linalg.norm(twist[3:]) < 1e-3
+            expected = (
+                np.array(PANDA.start) + np.array(point.velocities) * 0.01
+            )  # publish period, not CPU time
+            np.testing.assert_allclose(point.positions, expected, atol=1e-9)
+
+            # The sender stops: smooth stop, the zero command 5 times, then silence. The node's publisher
+            # keeps only the newest message (queue_size 1, as a controller wants), so on a busy machine a
+            # few may never reach us: count at most 5 zeros, at least one, and nothing after them.
+            sender.stop()
+            wait_until(lambda: not any(commands.last().points[0].velocities), 10, "a zero command")
+            seen = len(status.msgs)
+            wait_until(lambda: len(status.msgs) > seen + 30, 10, "30 more cycles")  # 0.3 s of node cycles
+            speeds = [float(np.linalg.norm(m.points[0].velocities)) for m in commands.msgs]
+            stop_at = speeds.index(0.0)
+            assert 1 <= len(speeds) - stop_at <= 5 and not any(speeds[stop_at:])
+            tail = speeds[stop_at - 3 : stop_at + 1]
+            assert all(a >= b for a, b in itertools.pairwise(tail)) and tail[0] > 0.0
+            assert any(m.code == StatusCode.STALE_COMMAND for m in status.msgs[seen:])
+
+            # NaN: refused with a reason, the arm holds still (no command at all).
+            commands.clear()
+            sender.pub.publish(twist_msg((math.nan, 0.0, 0.0, 0.0, 0.0, 0.0)))
+            wait_until(lambda: status.last().code == StatusCode.INVALID_COMMAND, 10, "INVALID_COMMAND")
+            assert "non-finite" in status.last().message
+            seen = len(status.msgs)
+            wait_until(lambda: len(status.msgs) > seen + 20, 10, "20 more cycles")
+            assert not commands.msgs
+
+            # A frame neither the URDF nor tf knows: refused too.
+            sender.pub.publish(twist_msg((0.05, 0.0, 0.0, 0.0, 0.0, 0.0), frame="nowhere"))
+            wait_until(lambda: "unknown frame" in status.last().message, 10, "unknown frame refusal")
+            assert not commands.msgs
+
+            # Still works afterwards: a -z twist in the hand frame.
+            sender.start(twist_msg((0.0, 0.0, -0.05, 0.0, 0.0, 0.0), frame=PANDA.tip))
+            commands.wait_for(20, timeout=10)
+            hand_z = model.frame_pose(np.array(PANDA.start), PANDA.tip).rotation[:, 2]
+            twist = eef_velocity(model, PANDA.start, commands.last().points[0].velocities)
+            assert angle_deg(twist[:3], -hand_z) < 1.0
+            sender.stop()
+        finally:
+            sender.stop()
+            commands.close()
+            status.close()
+        assert "refused" in node.output()  # the refusals were logged
+
+
+def test_velocity_output_tf_frame_pause_and_launch_file(ros_node, tmp_path) -> None:
+    """UR5 through the launch file with an override YAML: Float64MultiArray out, a tf-only command frame."""
+    import rospy as _rospy  # noqa: F401 (ros_node initialised it)
+    import tf2_ros
+    from geometry_msgs.msg import TransformStamped
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+    from std_srvs.srv import Trigger
+
+    rospy = ros_node
+    rospy.set_param("/robot_description", UR5.urdf)
+    override = tmp_path / "ur5_jog.yaml"
+    override.write_text(
+        "ee_frame_name: tool0\nplanning_frame: base_link\ncommand_in_type: unitless\n"
+        "scale: {linear: 0.1, rotational: 0.3}\ncommand_out_type: velocity_array\n"
+        "joint_topic: /jog_ur5/joint_states\ncmd_in_topic: /jog_ur5/twist\ncmd_out_topic: /jog_ur5/speed\n"
+        "pub_period: 0.004\nincoming_cmd_timeout: 0.5\nintegrate_from: measured\n"
+    )
+    # A camera frame only tf knows: x along the base's y.
+    broadcaster = tf2_ros.StaticTransformBroadcaster()
+    tf = TransformStamped()
+    tf.header.stamp = rospy.Time.now()
+    tf.header.frame_id, tf.child_frame_id = "base_link", "camera"
+    tf.transform.rotation.z, tf.transform.rotation.w = math.sin(math.pi / 4), math.cos(math.pi / 4)
+    broadcaster.sendTransform(tf)
+
+    model = ArmModel(UR5.urdf, UR5.tip)
+    joints = rospy.Publisher("/jog_ur5/joint_states", JointState, queue_size=1, latch=True)
+    state = JointState(name=list(model.joint_names), position=list(UR5.start))
+    joints.publish(state)
+    speeds = Collector("/jog_ur5/speed", Float64MultiArray)
+    name = "jog_test_ur5"
+    status = Collector(f"/{name}/status", JogStatus)
+    sender = Sender(rospy, "/jog_ur5/twist")
+    args = {"node_name": name, "override_config": str(override)}
+    with run_launch("jog_arm", "jog_arm.launch", args=args) as launched, node_log_on_failure(launched):
+        launched.wait_for_topic("/jog_ur5/speed")
+        try:
+            wait_until(lambda: sender.pub.get_num_connections() > 0, 20, "jog_arm_server subscribed")
+            wait_until(lambda: status.msgs and status.msgs[-1].code == StatusCode.STALE_COMMAND, 20, "state")
+            sender.start(twist_msg((0.5, 0.0, 0.0, 0.0, 0.0, 0.0), frame="camera"), rate=100.0)
+            speeds.wait_for(100, timeout=10)
+            velocities = speeds.last().data
+            assert len(velocities) == 6
+            twist = eef_velocity(model, UR5.start, velocities)
+            assert angle_deg(twist[:3], np.array([0.0, 1.0, 0.0])) < 1.0  # camera x = base y
+            assert np.linalg.norm(twist[:3]) == pytest.approx(0.05, rel=0.05)  # 0.5 x scale/linear
+
+            pause = rospy.ServiceProxy(f"/{name}/pause", Trigger)
+            assert pause().success
+            wait_until(
+                lambda: status.last().code == StatusCode.PAUSED and not any(speeds.last().data), 10, "stop"
+            )
+            assert rospy.ServiceProxy(f"/{name}/resume", Trigger)().success
+            wait_until(lambda: any(speeds.last().data), 10, "moving again after resume")
+        finally:
+            sender.stop()
+            speeds.close()
+            status.close()
+            joints.unregister()
+
+
+def test_invalid_configuration_refuses_to_start(ros_node) -> None:
+    rospy = ros_node
+    rospy.set_param("/robot_description", UR5.urdf)
+    name = "jog_test_refused"
+    set_params(rospy, name, {"singularity_threshold": 12.0, "hard_stop_singularity_threshold": 7.0})
+    with run_node("jog_arm", "jog_arm_server", name=name) as node:
+        wait_until(lambda: node.proc.poll() is not None, 30, "jog_arm_server to exit")
+        assert node.proc.returncode != 0
+        assert f"/{name}/hard_stop_singularity_threshold" in node.output()
+
+
+def test_simu_mode_sends_several_points(ros_node) -> None:
+    from sensor_msgs.msg import JointState
+    from trajectory_msgs.msg import JointTrajectory
+
+    rospy = ros_node
+    rospy.set_param("/robot_description", UR5.urdf)
+    name = "jog_test_simu"
+    set_params(
+        rospy,
+        name,
+        {
+            "simu": True,
+            "simu_points": 3,
+            "pub_period": 0.005,
+            "command_in_type": "speed_units",
+            "joint_topic": "/jog_simu/joint_states",
+            "cmd_in_topic": "/jog_simu/twist",
+            "cmd_out_topic": "/jog_simu/command",
+        },
+    )
+    joints = rospy.Publisher("/jog_simu/joint_states", JointState, queue_size=1, latch=True)
+    joints.publish(JointState(name=list(ArmModel(UR5.urdf, UR5.tip).joint_names), position=list(UR5.start)))
+    commands = Collector("/jog_simu/command", JointTrajectory)
+    sender = Sender(rospy, "/jog_simu/twist")
+    with run_node("jog_arm", "jog_arm_server", name=name) as node, node_log_on_failure(node):
+        node.wait_for_topic("/jog_simu/command")
+        try:
+            wait_until(lambda: sender.pub.get_num_connections() > 0, 20, "jog_arm_server subscribed")
+            sender.start(twist_msg((0.0, 0.0, 0.05, 0.0, 0.0, 0.0)))
+            msg = commands.wait_for(10, timeout=10)[-1]
+            times = [p.time_from_start.to_sec() for p in msg.points]
+            assert times == pytest.approx([0.005, 0.010, 0.015])
+            q = [np.array(p.positions) for p in msg.points]
+            v = np.array(msg.points[0].velocities)
+            np.testing.assert_allclose(q[2] - q[1], v * 0.005, atol=1e-12)  # extrapolated at the velocity
+        finally:
+            sender.stop()
+            commands.close()
+            joints.unregister()
+
+
+def test_pinocchio_frame_pose_matches_tf_convention() -> None:
+    """The quaternion conversion the node uses for tf frames (x, y, z, w) gives the rotation tf means."""
+    quat = pin.Quaternion(math.cos(math.pi / 4), 0.0, 0.0, math.sin(math.pi / 4))  # w, x, y, z
+    np.testing.assert_allclose(quat.toRotationMatrix() @ [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], atol=1e-12)
