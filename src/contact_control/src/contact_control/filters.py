@@ -4,12 +4,12 @@ Parameters as netft_utils used them: `delta_t` is the sample period [s] the filt
 `cutoff_freq` its cutoff [Hz]; the pre-warped bilinear transform uses Omega = tan(pi * cutoff * delta_t).
 The filter takes one step per received sample and never looks at clocks, so on a sensor that really publishes
 every T seconds the cutoff is `cutoff_freq * delta_t / T` Hz: the design fixes the cutoff as a fraction
-`cutoff_freq * delta_t` of the sample rate (0.12 for the defaults 0.2 s, 0.6 Hz; 0.33 for the Panda's
-0.62 s, 0.53 Hz). That product must stay below 0.5 (Nyquist).
+`cutoff_freq * delta_t` of the sample rate (0.12 for the defaults 0.2 s, 0.6 Hz; 0.33 for the thesis's
+real-robot override 0.62 s, 0.53 Hz). That product must stay below 0.5 (Nyquist).
 
 The original had `sqrt(2 * Omega + 1)` where the Butterworth denominator needs `sqrt(2) * Omega + 1`, so a
-steady force came out scaled by 1.129 (Panda settings) or 1.546 (defaults); `legacy_typo=True` reproduces it
-for comparison only.
+steady force came out scaled by 1.129 (real-robot override 0.62 s, 0.53 Hz) or 1.546 (defaults);
+`legacy_typo=True` reproduces it for comparison only.
 """
 
 from __future__ import annotations
