@@ -100,3 +100,10 @@ def test_unknown_demo_name_is_refused():
     with pytest.raises(KeyError, match="unknown demo"):
         by_name(["nope"])
     assert [s.name for s in by_name([])] == [s.name for s in SCENARIOS]
+
+
+def test_a_run_that_ended_before_its_push_fails_instead_of_crashing():
+    scenario = by_name(["hybrid"])[0]
+    early = _recording(0.5, x=_ramp(0.0, 0.5, -0.05), ends={"x": 1}, end_time=0.3)
+    verdict = judge(scenario, early)
+    assert not verdict.passed

@@ -49,6 +49,11 @@ def _window(t: np.ndarray, start: float, end: float) -> np.ndarray:
     return (t >= start) & (t <= end)
 
 
+def _max(values: np.ndarray) -> float:
+    """Largest value, NaN for an empty window (a run that ended early fails its checks, not the tool)."""
+    return float(np.max(values)) if values.size else float("nan")
+
+
 def _slope(t: np.ndarray, y: np.ndarray) -> float:
     if len(t) < 3:
         return float("nan")
@@ -79,9 +84,9 @@ def _follower(scenario: Scenario, rec: Recording) -> Verdict:
     v_z = _slope(rec.pose_t[win], rec.pose[win, 2])
     expected = push.force[2] / law.damping
     during = _window(rec.pose_t, push.start, push.end + 0.5)
-    drift_xy = float(np.max(np.linalg.norm(rec.pose[during, :2] - start[:2], axis=1)))
+    drift_xy = _max(np.linalg.norm(rec.pose[during, :2] - start[:2], axis=1))
     side = _window(rec.pose_t, side_push.start, side_push.end + 0.5)
-    side_move = float(np.max(np.linalg.norm(rec.pose[side] - _before(rec, side_push.start), axis=1)))
+    side_move = _max(np.linalg.norm(rec.pose[side] - _before(rec, side_push.start), axis=1))
     tail = _window(rec.pose_t, rec.pose_t[-1] - 1.0, rec.pose_t[-1])
     rest_speed = abs(_slope(rec.pose_t[tail], rec.pose[tail, 2]))
     figures = {
@@ -106,7 +111,7 @@ def _compliant(scenario: Scenario, rec: Recording) -> Verdict:
     end = rec.pose[-1]
     travel = float(start[2] - end[2])
     ended_by_force = rec.end_conditions.get("z") == 1
-    peak = float(np.max(np.abs(rec.contact_force[:, 2]))) if len(rec.contact_force) else float("nan")
+    peak = _max(np.abs(rec.contact_force[:, 2]))
     tail = _window(rec.pose_t, rec.pose_t[-1] - 0.8, rec.pose_t[-1])
     hold = float(np.ptp(rec.pose[tail, 2])) if np.any(tail) else float("nan")
     figures = {
@@ -132,8 +137,8 @@ def _spring(scenario: Scenario, rec: Recording) -> Verdict:
     rel = sign * (rec.pose[:, axis] - x0)
     during = _window(rec.pose_t, push.start, push.end)
     after = rec.pose_t > push.end
-    excursion = float(np.max(rel[during]))
-    overshoot = float(max(0.0, -np.min(rel[after])))
+    excursion = _max(rel[during])
+    overshoot = max(0.0, _max(-rel[after]))
     final = float(abs(rel[-1]))
     figures = {
         "excursion [mm]": excursion * 1e3,
@@ -157,7 +162,7 @@ def _hybrid(scenario: Scenario, rec: Recording) -> Verdict:
     ended_by_travel = rec.end_conditions.get("x") == 2
     z0 = _before(rec, push.start)[2]
     during = _window(rec.pose_t, push.start, push.end)
-    z_excursion = float(np.max(rec.pose[during, 2] - z0))
+    z_excursion = _max(rec.pose[during, 2] - z0)
     end_t = rec.move_end_time if rec.move_end_time is not None else rec.pose_t[-1]
     z_back = float(abs(_at(rec, end_t)[2] - z0))
     figures = {
