@@ -149,6 +149,28 @@ def test_compliant_move_stops_and_holds_when_it_meets_an_obstacle():
     assert -0.0505 < loop.pose[2, 3] < -0.05
 
 
+@pytest.mark.parametrize(("arm_time", "survives"), [(0.5, True), (0.0, False)])
+def test_force_limit_is_armed_once_the_axis_is_up_to_speed(arm_time, survives):
+    # A 1 kg tool speeding up at 2.5 m/s^2 reads 2.5 N on a wrist sensor, over a 0.5 N limit.
+    loop = ClosedLoop(controller(force_limit_arm_time=arm_time))
+    loop.start(laws(z=AxisLaw(LAW_COMPLIANT_MOVE, velocity=-0.05, force_limit=0.5, max_travel=0.5)))
+    mass, previous = 1.0, [0.0]
+
+    def inertia(t, pose):
+        v = loop.results[-1].velocity[2] if loop.results else 0.0
+        accel, previous[0] = (v - previous[0]) / DT, v
+        return unit(2, -mass * accel)
+
+    loop.run(inertia, 0.2)
+    assert loop.results[-1].move_active is survives
+    if survives:
+        assert loop.velocities()[-1, 2] == pytest.approx(-0.05)
+        loop.run(wall(loop.pose[2, 3] - 0.01), 1.0)  # armed now: contact still ends the move
+        assert loop.results[-1].end_conditions[2] == END_FT_VIOLATION
+    else:
+        assert loop.results[-1].end_conditions[2] == END_FT_VIOLATION
+
+
 def test_compliant_move_slows_down_and_ends_at_max_travel():
     loop = ClosedLoop(controller())
     loop.start(laws(x=AxisLaw(LAW_COMPLIANT_MOVE, velocity=0.1, max_travel=0.1)))

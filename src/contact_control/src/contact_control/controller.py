@@ -47,6 +47,8 @@ __all__ = ["AxisState", "ContactControl", "CycleResult"]
 
 _ZEROS = (0.0,) * 6
 
+_ARM_SETTLE = 0.1  # [s] at its law's velocity this long before an axis's force limit is armed
+
 
 class AxisState(NamedTuple):
     """One axis of a cycle, as in compliant_control_msgs/AxisState."""
@@ -155,6 +157,13 @@ class ContactControl:
         self._dt_nominal = 1.0 / s.control_rate
         self._diff = tuple(t.diff_max for t in self._tuning)
         self._windows = [ForceWindow(s.diff_window) for _ in range(6)]
+        # The tool's own inertia while an axis speeds up reads as force on a wrist sensor (1 kg at
+        # 0.5 m/s^2 is 0.5 N), so a small force limit is armed only once the axis has reached its law's
+        # velocity (and held it for _ARM_SETTLE, while the filtered reading settles), or after
+        # force_limit_arm_time.
+        self._arm_time = s.force_limit_arm_time
+        self._armed = [True] * 6
+        self._at_speed: list[float | None] = [None] * 6
         self._meter = TravelMeter(s.travel_directions)
         self._laws: list[AxisLaw] = [AxisLaw()] * 6
         self._law_types = [LAW_NONE] * 6
@@ -256,6 +265,8 @@ class ContactControl:
         for window in self._windows:
             window.clear()
         self._v = [0.0] * 6
+        self._armed = [self._arm_time <= 0.0] * 6
+        self._at_speed = [None] * 6
         self._travel = [0.0] * 6
         self._end = [END_NONE] * 6
         self._ended_axis = -1
@@ -347,8 +358,9 @@ class ContactControl:
                 self._meter.start(eef_pose, R_fixed_control)
             self._meter.measure(eef_pose, travel)
         laws = self._laws
+        armed = self._armed
         for i in self._active:
-            end = check_end(laws[i], w[i], travel[i])
+            end = check_end(laws[i], w[i] if armed[i] else 0.0, travel[i])
             if end:
                 return self._end_and_hold(t, i, end)
         for i in self._diff_axes:
@@ -359,8 +371,24 @@ class ContactControl:
         self._last_t = t
         v, tuning = self._v, self._tuning
         for i in self._active:
-            v[i] = shape_velocity(law_velocity(laws[i], tuning[i], w[i], travel[i]), v[i], tuning[i], dt)
+            target = law_velocity(laws[i], tuning[i], w[i], travel[i])
+            v[i] = shape_velocity(target, v[i], tuning[i], dt)
+            if not armed[i]:
+                armed[i] = self._arm(i, t, v[i] == target)
         return self._result(t, SAFETY_OK, "")
+
+    def _arm(self, axis: int, t: float, at_speed: bool) -> bool:
+        """Whether the axis's force limit is checked from now on (see force_limit_arm_time)."""
+        if t - (self._move_t0 or t) >= self._arm_time:
+            return True
+        if not at_speed:
+            self._at_speed[axis] = None
+            return False
+        since = self._at_speed[axis]
+        if since is None:
+            self._at_speed[axis] = t
+            return False
+        return t - since >= min(_ARM_SETTLE, self._arm_time)
 
     def check_stale(self, t: float) -> CycleResult | None:
         """Timer check: None while wrenches are fresh, else a zero-output result (SAFETY_STALE).

@@ -82,6 +82,10 @@ PARAMETERS: dict[str, tuple[str, Any, str, str]] = {
     "diff_max_force": ("nonneg", 0.0, "N", "force change within diff_window that ends a move (0: off)"),
     "diff_max_torque": ("nonneg", 0.0, "Nm", "same for torques"),
     "diff_window": ("pos", 0.1, "s", "time window of the force-jump check"),
+    "force_limit_arm_time": (
+        "nonneg", 0.5, "s",
+        "an axis's force limit is checked once it has reached its law's velocity, or after this (0: at once)",
+    ),
 }
 
 
@@ -157,6 +161,7 @@ class ContactControlSettings:
     diff_max_force: float = 0.0
     diff_max_torque: float = 0.0
     diff_window: float = 0.1
+    force_limit_arm_time: float = 0.5
     #: Keys of the input that are not parameters (the node warns about them).
     unknown_keys: tuple[str, ...] = field(default=(), compare=False)
 
