@@ -156,7 +156,7 @@ class ServoConfig:
         kv: Velocity gain [Nm s/rad].
         armature: Reflected rotor inertia added to each joint [kg m^2] (real geared drives have it; it also
             keeps stiff servos stable at the timestep).
-        max_acceleration: Setpoint acceleration limit in position and velocity modes [rad/s^2 or m/s^2].
+        max_acceleration: Setpoint acceleration limit in every command mode [rad/s^2 or m/s^2].
         payload_feedforward: Add the torque that holds the tool's weight (like a robot controller's payload
             setting), so the arm does not sag under it; the sensor still measures the weight.
     """

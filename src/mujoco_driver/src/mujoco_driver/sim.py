@@ -35,6 +35,9 @@ from mujoco_driver.scene import SceneModel, build_scene
 __all__ = ["CommandError", "Simulation", "TrajectoryPoint"]
 
 MODE_POSITION, MODE_VELOCITY, MODE_TRAJECTORY = "position", "velocity", "trajectory"
+# [1/s] Trajectory mode: the setpoint closes a position gap to the interpolated path with this rate (a 33 ms
+# time constant), on top of the path's own velocity.
+TRACKING_GAIN = 30.0
 
 
 class CommandError(ValueError):
@@ -88,7 +91,9 @@ class Simulation:
         self._q_desired = np.zeros(n)
         self._qd_desired = np.zeros(n)
         self._qd_command = np.zeros(n)
-        self._max_step = sc.velocity_limit * self.dt
+        self._correction = np.zeros(n)
+        self._scratch = np.zeros(n)
+        self._two_accel = 2.0 * sc.max_acceleration
         self._max_accel = sc.max_acceleration
         self._max_dv = self._max_accel * self.dt
         self._jacp = np.zeros((3, self.model.nv))
@@ -348,41 +353,63 @@ class Simulation:
     def _update_setpoint(self) -> None:
         """Advance the servo setpoint (``_q_target``, ``_qd_target``) by one step, within the joint limits.
 
+        In every mode the setpoint's velocity stays within the velocity limits and changes by at most
+        ``max_acceleration * dt`` per step, as a robot controller's rate limiter does: a late or jumping
+        command then gives a bounded acceleration (and a bounded inertial force on the wrist sensor)
+        instead of a spike.
         Position mode: a velocity- and acceleration-limited profile to the goal (brakes in time to stop).
         Velocity mode: the commanded velocity, reached with the acceleration limit, integrated.
-        Trajectory mode: the interpolated point, its rate clipped to the velocity limits.
+        Trajectory mode: the interpolated velocity plus a correction towards the interpolated position
+        (linear near the path, never faster than the joint can still brake), acceleration-limited.
         """
         dt, q_t, qd_t = self.dt, self._q_target, self._qd_target
         vel, err = self._qd_desired, self._q_desired
         if self._mode == MODE_TRAJECTORY:
-            self._sample_trajectory(self.time + dt, err, vel)
-            if self._mode == MODE_TRAJECTORY:
-                np.subtract(err, q_t, out=err)
-                np.clip(err, -self._max_step, self._max_step, out=err)
-                q_t += err
-                np.clip(vel, -self.scene.velocity_limit, self.scene.velocity_limit, out=qd_t)
-                return
-        if self._mode == MODE_VELOCITY:
+            self._sample_trajectory(self.time + dt, err, vel)  # may end it: then position mode below
+        if self._mode == MODE_TRAJECTORY:
+            np.subtract(err, q_t, out=err)
+            fix, brake = self._correction, self._scratch
+            np.abs(err, out=fix)
+            np.multiply(fix, self._two_accel, out=brake)
+            np.sqrt(brake, out=brake)
+            fix *= TRACKING_GAIN
+            np.minimum(fix, brake, out=fix)
+            np.copysign(fix, err, out=fix)
+            vel += fix
+        elif self._mode == MODE_VELOCITY:
             vel[:] = self._qd_command
         else:
             # Fastest speed from which the joint can still stop on the goal: sqrt(2 a |e|).
             np.subtract(self._goal, q_t, out=err)
             np.sqrt(2.0 * self._max_accel * np.abs(err), out=vel)
             np.copysign(vel, err, out=vel)
-            np.clip(vel, -self.scene.velocity_limit, self.scene.velocity_limit, out=vel)
-        np.clip(vel, qd_t - self._max_dv, qd_t + self._max_dv, out=qd_t)
-        if self._mode == MODE_VELOCITY:
+        np.clip(vel, -self.scene.velocity_limit, self.scene.velocity_limit, out=vel)
+        if self._mode == MODE_POSITION:
+            np.clip(vel, qd_t - self._max_dv, qd_t + self._max_dv, out=qd_t)
+        else:
+            # Scale the velocity change as a whole, so that a catch-up keeps the direction of motion (and the
+            # tool its Cartesian path) instead of the joints with the most to do lagging behind.
+            np.subtract(vel, qd_t, out=vel)
+            np.abs(vel, out=self._scratch)
+            self._scratch /= self._max_dv
+            ratio = float(self._scratch.max())
+            if ratio > 1.0:
+                vel /= ratio
+            qd_t += vel
+        if self._mode == MODE_POSITION:
+            # Snap onto the goal when this step reaches it at a speed the joint can drop in one step
+            # (a faster arrival overshoots a little and comes back, as an acceleration-limited stop does).
+            arrive = (np.abs(qd_t * dt) >= np.abs(err)) & (np.abs(qd_t) <= self._max_dv)
+            q_t += qd_t * dt
+            if arrive.any():
+                q_t[arrive] = self._goal[arrive]
+                qd_t[arrive] = 0.0
+        else:
             q_t += qd_t * dt
             outside = (q_t < self.scene.lower) | (q_t > self.scene.upper)
             if outside.any():
                 np.clip(q_t, self.scene.lower, self.scene.upper, out=q_t)
                 qd_t[outside] = 0.0
-        else:
-            arrive = np.abs(qd_t * dt) >= np.abs(err)
-            q_t += qd_t * dt
-            if arrive.any():
-                q_t[arrive] = self._goal[arrive]
-                qd_t[arrive] = 0.0
 
     def _sample_trajectory(self, now: float, q: np.ndarray, qd: np.ndarray) -> None:
         """Desired position and velocity of the trajectory at time ``now``; ends it after its last point."""

@@ -1,0 +1,395 @@
+"""mujoco_driver node: the rospy adapter around :class:`~mujoco_driver.sim.Simulation` (see the README).
+
+One loop in the main thread steps the simulation in real time (a fixed wall-clock grid, see
+:mod:`mujoco_driver.pacing`) and publishes the state; subscriber and service callbacks run in rospy's
+threads and only call into the simulation while holding ``_lock`` (``Simulation`` is not thread-safe).
+Messages and arrays are allocated once; the loop fills them in place.
+"""
+
+from __future__ import annotations
+
+import faulthandler
+import gc
+import math
+import os
+import signal
+import sys
+import threading
+import time
+from typing import Any
+
+import numpy as np
+import rospy
+import rospy.impl.simtime as simtime
+from compliant_control_msgs.srv import PushEEF, PushEEFResponse
+from geometry_msgs.msg import PoseStamped, WrenchStamped
+from rosgraph_msgs.msg import Clock
+from rospy.rostime import _set_rostime
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64, Float64MultiArray
+from std_srvs.srv import Trigger, TriggerResponse
+from trajectory_msgs.msg import JointTrajectory
+
+from mujoco_driver.commands import trajectory_points, velocity_vector
+from mujoco_driver.config import ConfigError, SceneConfig
+from mujoco_driver.pacing import Pacer, RtfMeter
+from mujoco_driver.params import DriverSettings, ParamError, load_scene, urdf_root_link
+from mujoco_driver.scene import SceneError
+from mujoco_driver.sim import CommandError, Simulation
+
+__all__ = ["MujocoDriverNode", "main"]
+
+_WARN_PERIOD = 2.0  # [s] throttle of warnings about bad commands
+_MAX_STAMP_AGE = 0.1  # [s] older trajectory stamps are taken as "now"
+_MAX_STAMP_AHEAD = 1.0  # [s] stamps further in the future too
+
+
+class MujocoDriverNode:
+    """Topics, services and the stepping loop around one :class:`Simulation`.
+
+    Args:
+        settings: The validated node parameters.
+        urdf: The robot description.
+        scene_cfg: The scene settings.
+
+    Raises:
+        ConfigError, SceneError: If the URDF and the scene do not make a simulation.
+    """
+
+    def __init__(self, settings: DriverSettings, urdf: str, scene_cfg: SceneConfig) -> None:
+        self._s = s = settings
+        self._sim = sim = Simulation(urdf, scene_cfg)
+        self._lock = threading.Lock()
+        self._base_frame = s.base_frame or urdf_root_link(urdf)
+        self._clock_offset = 0.0  # simulated time before the last ~reset, so /clock never runs backwards
+        self._publish_every = s.publish_every(sim.dt)
+        self._last_velocity_command = -math.inf  # [s of sim time]
+        self._velocity_active = False
+        self._zero = np.zeros(len(sim.joint_names))
+
+        # State buffers, filled under the lock, published outside it.
+        n, scene, data = len(sim.joint_names), sim.scene, sim.data
+        self._q, self._qd, self._tau, self._w = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(6)
+        self._xpos, self._xquat = np.zeros(3), np.zeros(4)
+        self._qpos_adr, self._dof_adr = scene.qpos_adr, scene.dof_adr
+        self._xpos_src, self._xquat_src = data.xpos[scene.eef_body], data.xquat[scene.eef_body]
+        self._sim_time = 0.0
+
+        # Preallocated messages.
+        self._joint_msg = JointState(name=list(sim.joint_names))
+        self._wrench_msg = WrenchStamped()
+        self._wrench_msg.header.frame_id = s.ft_frame or scene_cfg.links.ft_sensor
+        self._pose_msg = PoseStamped()
+        self._pose_msg.header.frame_id = self._base_frame
+        self._clock_msg = Clock()
+        self._rtf_msg = Float64()
+        self._stamp = rospy.Time()
+
+        # rospy's Publisher does take tcp_nodelay (TCP_NODELAY on the publisher's socket; subscribers may ask
+        # for it too). With a queue_size, publish() hands the bytes to a writer thread per subscriber, so a
+        # stalled subscriber cannot block the loop; synchronous publishing writes the socket in this thread,
+        # which costs about 40 % less CPU, but a subscriber that stops reading (`rostopic echo | less`)
+        # would freeze the simulation once its socket buffer is full.
+        queue = None if s.publish_synchronously else 10
+
+        def publisher(name: str, cls: type) -> rospy.Publisher:
+            return rospy.Publisher(name, cls, queue_size=queue, tcp_nodelay=True)
+
+        self._joint_pub = publisher(s.joint_states_topic, JointState)
+        self._wrench_pub = publisher(s.wrench_topic, WrenchStamped)
+        self._pose_pub = publisher("~eef_pose", PoseStamped)
+        self._rtf_pub = publisher("~rtf", Float64)
+        self._clock_pub = publisher("/clock", Clock) if s.publish_clock else None
+        if self._clock_pub is not None and getattr(simtime, "_clock_sub", None) is not None:
+            simtime._clock_sub.unregister()  # see _publish_clock
+            simtime._clock_sub = None
+        self._subs = [
+            rospy.Subscriber(s.trajectory_command_topic, JointTrajectory, self._on_trajectory,
+                             queue_size=1, tcp_nodelay=True),
+            rospy.Subscriber(s.velocity_command_topic, Float64MultiArray, self._on_velocity,
+                             queue_size=1, tcp_nodelay=True),
+            rospy.Subscriber("~push_wrench", WrenchStamped, self._on_push_wrench, queue_size=1,
+                             tcp_nodelay=True),
+        ]
+        self._services = [
+            rospy.Service("~push", PushEEF, self._on_push),
+            rospy.Service("~reset", Trigger, self._on_reset),
+        ]
+        self._viewer = self._open_viewer() if s.viewer else None
+        self._warned: dict[str, int] = {}
+        self._last_warning: dict[str, float] = {}
+        self._stop_requested = False
+        rospy.loginfo(
+            "mujoco_driver: %d joints %s, dt %.4f s, real-time factor %s, publishing every %d step(s)%s",
+            n, list(sim.joint_names), sim.dt, s.real_time_factor or "max", self._publish_every,
+            ", /clock" if s.publish_clock else "",
+        )
+
+    @property
+    def dt(self) -> float:
+        """Simulation timestep [s]."""
+        return self._sim.dt
+
+    # ------------------------------------------------------------------ loop
+    def stop(self) -> None:
+        """Ask the loop to end after the current step (safe to call from a signal handler)."""
+        self._stop_requested = True
+
+    def run(self) -> None:
+        """Step and publish until :meth:`stop` or a ROS shutdown."""
+        s, sim = self._s, self._sim
+        pacer = Pacer(sim.dt, s.real_time_factor, s.max_lag)
+        meter = RtfMeter(s.rtf_period)
+        countdown = 0
+        next_view = 0.0
+        pacer.start(time.monotonic())
+        self._read_state()
+        while not (self._stop_requested or rospy.is_shutdown()):
+            wait = pacer.wait_time(time.monotonic())
+            if wait > 0.0:
+                time.sleep(wait)  # ahead of the wall clock: the only sleep, never while catching up
+                continue
+            countdown -= 1
+            # Catching up after a stall: step without publishing the intermediate states (publishing costs
+            # several times the physics), so the simulation is back on time sooner; the newest state goes out.
+            catching_up = pacer.lag(time.monotonic()) > pacer.period
+            publish = countdown <= 0 and not catching_up
+            with self._lock:
+                self._watchdog()
+                sim.step()
+                if publish:
+                    self._read_state()
+                else:
+                    self._sim_time = sim.time
+            pacer.step_done()
+            if self._clock_pub is not None and not catching_up:
+                self._publish_clock()
+            if publish:
+                countdown = self._publish_every
+                self._publish()
+            now = time.monotonic()
+            if meter.update(now, self._clock_offset + self._sim_time):
+                self._report(meter.value, pacer.dropped)
+            if self._viewer is not None and now >= next_view:
+                next_view = now + s.viewer_period
+                self._sync_viewer()
+        if self._viewer is not None:
+            self._viewer.close()
+
+    def _watchdog(self) -> None:
+        """Velocity target to zero when velocity commands stopped coming (like a real velocity controller)."""
+        if self._velocity_active and self._sim.time - self._last_velocity_command > self._s.command_timeout:
+            self._velocity_active = False
+            if self._sim.mode == "velocity":
+                self._sim.set_velocity_targets(self._zero)
+                rospy.loginfo_throttle(_WARN_PERIOD, "mujoco_driver: velocity commands stopped: stopping")
+
+    def _read_state(self) -> None:
+        sim = self._sim
+        data = sim.data
+        np.take(data.qpos, self._qpos_adr, out=self._q)
+        np.take(data.qvel, self._dof_adr, out=self._qd)
+        np.take(data.qfrc_actuator, self._dof_adr, out=self._tau)
+        sim.wrench(out=self._w)
+        self._xpos[:] = self._xpos_src
+        self._xquat[:] = self._xquat_src
+        self._sim_time = sim.time
+
+    def _now(self) -> float:
+        """The stamp clock [s]: simulated time with /clock, else the wall clock."""
+        return self._clock_offset + self._sim_time if self._clock_pub is not None else time.time()
+
+    def _set_stamp(self) -> None:
+        """Fill the shared stamp (main loop only: published messages reference it)."""
+        seconds = self._now()
+        secs = int(seconds)
+        self._stamp.secs, self._stamp.nsecs = secs, int((seconds - secs) * 1e9)
+
+    def _publish_clock(self) -> None:
+        self._set_stamp()
+        self._clock_msg.clock = self._stamp
+        self._clock_pub.publish(self._clock_msg)
+        # This node's own rospy clock: set directly instead of through its /clock subscription (dropped in
+        # __init__), which would deserialise every message this loop publishes. A fresh Time, because rospy
+        # hands the object itself to callers of rospy.Time.now().
+        _set_rostime(rospy.Time(self._stamp.secs, self._stamp.nsecs))
+
+    def _publish(self) -> None:
+        self._set_stamp()
+        joint = self._joint_msg
+        joint.header.stamp = self._stamp
+        # Lists serialise fastest in genpy (numpy scalars go through a slower path).
+        joint.position, joint.velocity, joint.effort = self._q.tolist(), self._qd.tolist(), self._tau.tolist()
+        self._joint_pub.publish(joint)
+        w, msg = self._w, self._wrench_msg
+        msg.header.stamp = self._stamp
+        f, t = msg.wrench.force, msg.wrench.torque
+        f.x, f.y, f.z, t.x, t.y, t.z = w.tolist()
+        self._wrench_pub.publish(msg)
+        pose = self._pose_msg
+        pose.header.stamp = self._stamp
+        p, o = pose.pose.position, pose.pose.orientation
+        p.x, p.y, p.z = self._xpos.tolist()
+        o.w, o.x, o.y, o.z = self._xquat.tolist()  # MuJoCo quaternions are (w, x, y, z)
+        self._pose_pub.publish(pose)
+
+    def _report(self, rtf: float, dropped: float) -> None:
+        self._rtf_msg.data = rtf
+        self._rtf_pub.publish(self._rtf_msg)
+        target = self._s.real_time_factor
+        rospy.logdebug("mujoco_driver: real-time factor %.3f", rtf)
+        if target > 0.0 and rtf < 0.9 * target:
+            rospy.logwarn_throttle(
+                10.0, "mujoco_driver: real-time factor %.2f (asked %.2f); %.2f s of backlog dropped so far",
+                rtf, target, dropped,
+            )
+        with self._lock:
+            warnings = self._sim.warnings()
+        if warnings != self._warned:
+            rospy.logwarn("mujoco_driver: MuJoCo warnings since the last reset: %s", warnings)
+            self._warned = warnings
+
+    # ---------------------------------------------------------------- viewer
+    def _open_viewer(self) -> Any:
+        if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+            rospy.logwarn("mujoco_driver: ~viewer is true but there is no DISPLAY: running headless")
+            return None
+        try:
+            import mujoco.viewer
+
+            return mujoco.viewer.launch_passive(self._sim.model, self._sim.data)
+        except Exception as exc:  # any GL/GLFW failure: go on headless
+            rospy.logwarn("mujoco_driver: cannot open the viewer (%s): running headless", exc)
+            return None
+
+    def _sync_viewer(self) -> None:
+        if not self._viewer.is_running():
+            self._viewer = None  # the user closed the window; the simulation goes on
+            return
+        with self._lock:
+            self._viewer.sync()
+
+    # -------------------------------------------------------------- commands
+    def _reject(self, what: str, exc: Exception) -> None:
+        """Warn about a refused command, at most every _WARN_PERIOD per kind (rospy's throttle is per call
+        site, so one kind of bad command would hide another)."""
+        now = time.monotonic()
+        if now - self._last_warning.get(what, -math.inf) >= _WARN_PERIOD:
+            self._last_warning[what] = now
+            rospy.logwarn(f"mujoco_driver: {what} ignored: {exc}")
+
+    def _on_trajectory(self, msg: JointTrajectory) -> None:
+        raw = [(p.positions, p.velocities, p.time_from_start.to_sec()) for p in msg.points]
+        stamp = msg.header.stamp.to_sec()
+        with self._lock:
+            sim = self._sim
+            try:
+                points = trajectory_points(msg.joint_names, raw, sim.joint_indices, sim.position_targets)
+                start = None
+                if stamp > 0.0:
+                    # As ros_control's trajectory controller: the trajectory starts at its stamp, so a sender
+                    # that stamps its messages gets no jitter from the transport. A stamp further off than
+                    # _MAX_STAMP_AGE back or _MAX_STAMP_AHEAD ahead (another clock?) starts now.
+                    delay = stamp - self._now()
+                    if -_MAX_STAMP_AGE <= delay <= _MAX_STAMP_AHEAD:
+                        start = sim.time + delay
+                    else:
+                        when = f"{-delay:.3f} s ago" if delay < 0 else f"{delay:.3f} s ahead"
+                        self._reject("trajectory stamp", CommandError(
+                            f"stamped {when} (clocks differ?): started now instead"))
+                sim.set_trajectory(points, start_time=start)
+            except CommandError as exc:
+                self._reject("trajectory", exc)
+                return
+            self._velocity_active = False
+
+    def _on_velocity(self, msg: Float64MultiArray) -> None:
+        with self._lock:
+            sim = self._sim
+            try:
+                sim.set_velocity_targets(velocity_vector(msg.data, sim.joint_names))
+            except CommandError as exc:
+                self._reject("velocity command", exc)
+                return
+            self._last_velocity_command = sim.time
+            self._velocity_active = True
+
+    def _check_push_frame(self, frame: str) -> None:
+        if frame and frame.lstrip("/") != self._base_frame:
+            raise CommandError(f"push wrench frame must be {self._base_frame!r} (or empty), got {frame!r}")
+
+    def _on_push_wrench(self, msg: WrenchStamped) -> None:
+        f, t = msg.wrench.force, msg.wrench.torque
+        with self._lock:
+            try:
+                self._check_push_frame(msg.header.frame_id)
+                self._sim.push((f.x, f.y, f.z), (t.x, t.y, t.z), duration=self._s.push_timeout)
+            except CommandError as exc:
+                self._reject("push_wrench", exc)
+
+    def _on_push(self, req: Any) -> PushEEFResponse:
+        f, t = req.wrench.force, req.wrench.torque
+        with self._lock:
+            try:
+                self._sim.push((f.x, f.y, f.z), (t.x, t.y, t.z), duration=req.duration)
+            except CommandError as exc:
+                rospy.logwarn("mujoco_driver: ~push refused: %s", exc)
+                return PushEEFResponse(success=False, message=str(exc))
+        message = (f"pushing force [{f.x:g}, {f.y:g}, {f.z:g}] N, torque [{t.x:g}, {t.y:g}, {t.z:g}] Nm "
+                   f"({self._base_frame}) for {req.duration:g} s")
+        return PushEEFResponse(success=True, message=message)
+
+    def _on_reset(self, _req: Any) -> TriggerResponse:
+        with self._lock:
+            self._clock_offset += self._sim.time
+            self._sim.reset()
+            self._velocity_active = False
+            self._read_state()
+        return TriggerResponse(success=True, message="back at the start pose, holding position")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``mujoco_driver`` executable."""
+    # rospy's own SIGINT/SIGTERM handler closes every connection inside the signal handler, i.e. in the main
+    # thread, which deadlocks when the signal lands while this thread is inside publish() holding a
+    # connection's lock (one shutdown in ~10 at 1500 messages/s left the node hanging). Our handler only
+    # asks the loop to stop; ROS is shut down afterwards, outside any publish().
+    rospy.init_node("mujoco_driver", argv=argv if argv is not None else sys.argv, disable_signals=True)
+    node: MujocoDriverNode | None = None
+    stop_early = []
+
+    def on_signal(_signum: int, _frame: Any) -> None:
+        if node is not None:
+            node.stop()
+        else:
+            stop_early.append(True)
+
+    signal.signal(signal.SIGINT, on_signal)
+    signal.signal(signal.SIGTERM, on_signal)
+    try:
+        params = rospy.get_param("~", {})
+        use_sim_time = bool(rospy.get_param("/use_sim_time", False))
+        settings = DriverSettings.from_params(params, use_sim_time=use_sim_time)
+        for key in DriverSettings.unknown_keys(params):
+            rospy.logwarn("mujoco_driver: ~%s is not a driver parameter, ignored", key)
+        if not rospy.has_param("robot_description"):
+            raise ParamError(f"{rospy.resolve_name('robot_description')} is not set (the URDF)")
+        urdf = rospy.get_param("robot_description")
+        node = MujocoDriverNode(settings, urdf, load_scene(settings))
+    except (ParamError, ConfigError, SceneError) as exc:
+        rospy.logfatal("mujoco_driver: %s", exc)
+        rospy.signal_shutdown("bad configuration")
+        return 1
+    if settings.publish_clock and not rospy.get_param("/use_sim_time", False):
+        rospy.logwarn("mujoco_driver: publishing /clock but /use_sim_time is false: other nodes use the wall "
+                      "clock and see stamps in simulated time")
+    # Start-up objects (MuJoCo model, rospy machinery) live for good: keep them out of the collector's full
+    # passes, which would stall a step for milliseconds now and then. A thread waiting for the GIL waits up
+    # to the switch interval (5 ms by default) for a busy one: keep it well below the timestep.
+    gc.freeze()
+    faulthandler.register(signal.SIGUSR1, all_threads=True)  # `kill -USR1 <pid>`: every thread's stack
+    sys.setswitchinterval(min(sys.getswitchinterval(), node.dt / 4.0))
+    if not stop_early:
+        node.run()
+    rospy.signal_shutdown("stopped")
+    return 0

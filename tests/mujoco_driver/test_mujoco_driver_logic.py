@@ -1,0 +1,204 @@
+"""The driver node's pure parts, no ROS: real-time pacing, the real-time factor, parameters, commands."""
+
+from __future__ import annotations
+
+import math
+import pathlib
+
+import numpy as np
+import pytest
+import yaml
+from mujoco_driver.commands import trajectory_points, velocity_vector
+from mujoco_driver.pacing import Pacer, RtfMeter
+from mujoco_driver.params import DriverSettings, ParamError, load_scene, urdf_root_link
+from mujoco_driver.scene import SceneError
+from mujoco_driver.sim import CommandError, Simulation
+
+from mujoco_driver.config import ConfigError
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+NAMES = ("a", "b", "c")
+
+
+def _indices(names):
+    try:
+        return np.array([NAMES.index(n) for n in names])
+    except ValueError:
+        raise CommandError(f"unknown joint in {names}") from None
+
+
+# ---------------------------------------------------------------- pacing
+def test_pacer_steps_on_a_fixed_grid_and_sleeps_only_when_ahead():
+    pacer = Pacer(dt=0.002, real_time_factor=1.0)
+    pacer.start(10.0)
+    assert pacer.wait_time(10.0) == 0.0
+    pacer.step_done()
+    assert pacer.wait_time(10.0005) == pytest.approx(0.0015)
+    # 10 ms late: the steps due at 10.002 ... 10.012 come at once (no sleeping while catching up).
+    now = 10.0121
+    due = 0
+    while pacer.wait_time(now) == 0.0:
+        pacer.step_done()
+        due += 1
+    assert due == 6
+    assert pacer.wait_time(now) == pytest.approx(0.0019)
+    assert pacer.dropped == 0.0
+    assert pacer.lag(now) == 0.0
+
+
+def test_pacer_lag_tells_how_far_behind_the_loop_is():
+    pacer = Pacer(dt=0.002, real_time_factor=1.0)
+    pacer.start(0.0)
+    pacer.step_done()
+    assert pacer.lag(0.001) == 0.0
+    assert pacer.lag(0.0075) == pytest.approx(0.0055)
+    fast = Pacer(dt=0.002, real_time_factor=0.0)
+    fast.start(0.0)
+    assert fast.lag(5.0) == 0.0  # as fast as possible: never behind
+
+
+def test_pacer_drops_a_backlog_longer_than_max_lag():
+    pacer = Pacer(dt=0.002, real_time_factor=1.0, max_lag=0.1)
+    pacer.start(0.0)
+    pacer.step_done()
+    assert pacer.wait_time(1.0) == 0.0  # a 1 s stall: resynchronised instead of 500 catch-up steps
+    assert pacer.dropped == pytest.approx(0.998)
+    pacer.step_done()
+    assert pacer.wait_time(1.0) == pytest.approx(0.002)
+
+
+@pytest.mark.parametrize("factor, period", [(2.0, 0.001), (0.5, 0.004), (0.0, 0.0)])
+def test_pacer_period_follows_the_real_time_factor(factor, period):
+    pacer = Pacer(dt=0.002, real_time_factor=factor)
+    assert pacer.period == pytest.approx(period)
+    pacer.start(0.0)
+    pacer.step_done()
+    assert (pacer.wait_time(0.0) > 0.0) == (factor > 0.0)
+
+
+@pytest.mark.parametrize("kwargs", [{"dt": 0.0}, {"dt": 0.002, "real_time_factor": -1.0},
+                                    {"dt": 0.002, "max_lag": 0.0}, {"dt": math.nan}])
+def test_pacer_refuses_bad_settings(kwargs):
+    with pytest.raises(ValueError):
+        Pacer(**kwargs)
+
+
+def test_rtf_meter_reports_simulated_over_wall_time_per_window_and_restarts_on_reset():
+    meter = RtfMeter(period=1.0)
+    assert not meter.update(0.0, 0.0)
+    assert not meter.update(0.5, 0.4)
+    assert meter.update(1.0, 0.9)
+    assert meter.value == pytest.approx(0.9)
+    assert meter.update(2.0, 2.9)
+    assert meter.value == pytest.approx(2.0)
+    assert not meter.update(2.5, 0.1)  # simulated time went back (reset): new window, value kept
+    assert meter.value == pytest.approx(2.0)
+    assert meter.update(3.5, 1.1)
+    assert meter.value == pytest.approx(1.0)
+
+
+# ---------------------------------------------------------------- params
+def test_settings_defaults_and_clock_default_from_use_sim_time():
+    s = DriverSettings.from_params({"scene_config": "/x/sim.yaml"})
+    assert (s.real_time_factor, s.publish_clock, s.command_timeout, s.push_timeout) == (1.0, False, 0.1, 0.2)
+    assert s.trajectory_command_topic == "arm_controller/command"
+    assert s.velocity_command_topic == "joint_group_velocity_controller/command"
+    assert s.publish_every(0.002) == 1
+    assert DriverSettings.from_params({"scene_config": "x"}, use_sim_time=True).publish_clock
+    assert DriverSettings.from_params({"scene_config": "x", "publish_period": 0.01}).publish_every(0.002) == 5
+
+
+def test_faster_than_real_time_needs_the_clock():
+    with pytest.raises(ParamError, match="real_time_factor"):
+        DriverSettings.from_params({"scene_config": "x", "real_time_factor": 2.0})
+    with pytest.raises(ParamError, match="real_time_factor"):
+        DriverSettings.from_params({"scene_config": "x", "real_time_factor": 0})
+    fast = DriverSettings.from_params({"scene_config": "x", "real_time_factor": 0, "publish_clock": True})
+    assert fast.real_time_factor == 0.0
+
+
+@pytest.mark.parametrize("params, key", [
+    ({}, "scene_config"),
+    ({"scene_config": "x", "scene": {"timestep": 0.002}}, "scene"),
+    ({"scene_config": "x", "command_timeout": 0.0}, "command_timeout"),
+    ({"scene_config": "x", "push_timeout": "long"}, "push_timeout"),
+    ({"scene_config": "x", "viewer": "yes"}, "viewer"),
+    ({"scene_config": "x", "publish_period": -0.1}, "publish_period"),
+    ({"scene_config": "x", "wrench_topic": ""}, "wrench_topic"),
+    ({"scene_config": "x", "start_pose": 1.0}, "start_pose"),
+    ({"scene_config": "x", "real_time_factor": math.nan}, "real_time_factor"),
+])
+def test_bad_parameters_are_refused_naming_the_key(params, key):
+    with pytest.raises(ParamError, match=key):
+        DriverSettings.from_params(params)
+
+
+def test_unknown_keys_are_reported():
+    assert DriverSettings.unknown_keys({"scene_config": "x", "rtf": 1, "viewer": False}) == ["rtf"]
+
+
+def test_urdf_root_link():
+    urdf = ('<robot name="r"><link name="world"/><link name="base"/><link name="tip"/>'
+            '<joint name="j0" type="fixed"><parent link="world"/><child link="base"/></joint>'
+            '<joint name="j1" type="fixed"><parent link="base"/><child link="tip"/></joint></robot>')
+    assert urdf_root_link(urdf) == "world"
+    with pytest.raises(ParamError, match="root"):
+        urdf_root_link('<robot name="r"><link name="a"/><link name="b"/></robot>')
+    with pytest.raises(ParamError, match="XML"):
+        urdf_root_link("<robot")
+
+
+def test_scene_from_a_mapping_with_the_start_pose_overridden(robot):
+    scene = yaml.safe_load((ROOT / "src" / robot.package / "config" / "sim.yaml").read_text())
+    pose = [0.1 * (i + 1) - 0.2 for i in range(robot.pin_model.nq)]
+    pose[3] = scene["start_pose"][list(scene["start_pose"])[3]]  # keep the elbow-like joints in range
+    cfg = load_scene(DriverSettings.from_params({"scene": scene, "start_pose": pose}))
+    sim = Simulation(robot.urdf, cfg)
+    np.testing.assert_allclose(sim.qpos, pose)
+    sim.step(10)
+    sim.reset()
+    np.testing.assert_allclose(sim.qpos, pose)  # ~reset returns to the override
+
+
+def test_bad_scene_inputs_are_refused_naming_the_key(robot, tmp_path):
+    with pytest.raises(ConfigError, match="cannot read"):
+        load_scene(DriverSettings.from_params({"scene_config": str(tmp_path / "missing.yaml")}))
+    scene_file = ROOT / "src" / robot.package / "config" / "sim.yaml"
+    cfg = load_scene(DriverSettings.from_params({"scene_config": str(scene_file),
+                                                 "start_pose": {"no_such_joint": 0.0}}))
+    with pytest.raises(SceneError, match="~start_pose: joints missing"):
+        Simulation(robot.urdf, cfg)
+
+
+# ---------------------------------------------------------------- commands
+def test_velocity_vector_checks_length_and_values():
+    assert velocity_vector([0.1, 0.2, 0.3], NAMES).tolist() == [0.1, 0.2, 0.3]
+    with pytest.raises(CommandError, match="expected 3"):
+        velocity_vector([0.1, 0.2], NAMES)
+    with pytest.raises(CommandError, match="finite"):
+        velocity_vector([0.1, math.nan, 0.3], NAMES)
+
+
+def test_trajectory_points_reorder_and_fill_missing_joints_with_the_hold_position():
+    hold = np.array([1.0, 2.0, 3.0])
+    points = trajectory_points(["c", "a"], [([30.0, 10.0], [0.3, 0.1], 0.5), ([31.0, 11.0], [], 1.0)],
+                               _indices, hold)
+    assert points[0].positions.tolist() == [10.0, 2.0, 30.0]
+    assert points[0].velocities.tolist() == [0.1, 0.0, 0.3]
+    assert points[0].time_from_start == 0.5
+    assert points[1].positions.tolist() == [11.0, 2.0, 31.0] and points[1].velocities is None
+    assert hold.tolist() == [1.0, 2.0, 3.0]
+
+
+@pytest.mark.parametrize("names, points, match", [
+    ([], [([1.0], [], 1.0)], "no joint_names"),
+    (["a", "a"], [([1.0, 2.0], [], 1.0)], "duplicate"),
+    (["a"], [], "no points"),
+    (["x"], [([1.0], [], 1.0)], "unknown"),
+    (["a", "b"], [([1.0], [], 1.0)], "positions"),
+    (["a", "b"], [([1.0, 2.0], [0.1], 1.0)], "velocities"),
+    (["a"], [([math.inf], [], 1.0)], "finite"),
+])
+def test_trajectory_points_refuse_malformed_messages(names, points, match):
+    with pytest.raises(CommandError, match=match):
+        trajectory_points(names, points, _indices, np.zeros(3))

@@ -1,0 +1,108 @@
+"""End to end, per robot: `roslaunch <robot>_custom sim.launch` brings up the whole stack, a twist into
+jog_arm's input moves the tool tip that way, contact_control's follower makes the tool give way to a simulated
+push, and everything shuts down cleanly."""
+
+from __future__ import annotations
+
+import os
+import xmlrpc.client
+
+import numpy as np
+import pytest
+
+pytest.importorskip("cartesian_impedance_msgs.srv", reason="needs devel/setup.bash (make test sources it)")
+
+from cartesian_impedance_msgs.msg import ControlLaw
+from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
+from compliant_control_msgs.msg import ContactControlStatus, JogStatus
+from compliant_control_msgs.srv import PushEEF, PushEEFRequest
+from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
+from harness.launch import run_launch
+from harness.waiting import Collector, wait_until
+from sensor_msgs.msg import JointState
+from std_srvs.srv import Trigger
+
+BASE_FRAME = {"ur5_custom": "base_link", "panda_custom": "panda_link0"}
+TOPICS = ("/joint_states", "/wrench", "/tf", "/mujoco_driver/eef_pose")
+SERVICES = ("/configure_cartesian_impedance", "/configure_cartesian_impedance_blocking",
+            "/contact_control_node/tare", "/contact_control_node/stop", "/jog_arm_server/pause",
+            "/mujoco_driver/push", "/mujoco_driver/reset")
+NODES = ("/mujoco_driver", "/jog_arm_server", "/contact_control_node", "/robot_state_publisher")
+
+
+def _registered_nodes() -> set[str]:
+    code, _, state = xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"]).getSystemState("/probe")
+    assert code == 1
+    return {node for kind in state for _, nodes in kind for node in nodes}
+
+
+@pytest.mark.parametrize("robot", sorted(BASE_FRAME))
+def test_sim_stack_comes_up_jogs_follows_a_push_and_shuts_down(ros_node, robot):
+    rospy = ros_node
+    with run_launch(robot, "sim.launch") as h:
+        for topic in TOPICS:
+            h.wait_for_topic(topic, timeout=40)
+        for service in SERVICES:
+            h.wait_for_service(service, timeout=40)
+        # Few subscribers in this process: on 2 cores its load delays the stack's messages.
+        pose = Collector("/mujoco_driver/eef_pose", PoseStamped)
+        joints = Collector("/joint_states", JointState)
+        cc_status = Collector("/contact_control_node/status", ContactControlStatus)
+        twist_pub = rospy.Publisher("/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1,
+                                    tcp_nodelay=True)
+        try:
+            for c in (pose, joints, cc_status):
+                c.wait_for(1, timeout=20)
+            rospy.wait_for_message("/wrench", WrenchStamped, timeout=10)
+            rospy.wait_for_message("/jog_arm_server/status", JogStatus, timeout=10)
+            wait_until(lambda: twist_pub.get_num_connections() > 0, 10, "jog_arm to subscribe to its input")
+
+            def tip() -> np.ndarray:
+                p = pose.last().pose.position
+                return np.array([p.x, p.y, p.z])
+
+            def settle() -> None:
+                wait_until(lambda: np.max(np.abs(joints.last().velocity)) < 2e-3, 10, "the arm to stop")
+
+            # 1. A twist into jog_arm's input (the keyboard's path): 5 cm/s along -X of the base frame.
+            start = tip()
+            twist = TwistStamped()
+            twist.header.frame_id = BASE_FRAME[robot]
+            twist.twist.linear.x = -0.05
+            rate = rospy.Rate(50)
+            while start[0] - tip()[0] < 0.02:
+                assert h.proc.poll() is None, h.output()[-3000:]
+                twist.header.stamp = rospy.Time.now()
+                twist_pub.publish(twist)
+                rate.sleep()  # the sender's rate, not a wait for a result
+            moved = tip() - start
+            assert np.all(np.abs(moved[1:]) < 0.25 * abs(moved[0])), f"tool tip left the X line: {moved}"
+            settle()
+            status = rospy.wait_for_message("/jog_arm_server/status", JogStatus, timeout=10)
+            assert status.code in (JogStatus.NO_WARNING, JogStatus.STALE_COMMAND), status
+
+            # 2. contact_control: a follower on X (b = 200 N s/m: 5 cm/s for 10 N) gives way to a push.
+            req = ConfigureForceControlRequest()
+            req.cart_impedance_params.damping.translational.x = 200.0
+            req.direction_control_laws.x.type = ControlLaw.TYPE_FOLLOWER
+            configure = rospy.ServiceProxy("/configure_cartesian_impedance", ConfigureForceControl)
+            assert configure(req).success, h.output()[-3000:]
+            wait_until(lambda: cc_status.last().move_active, 5, "the follower to be active")
+            before = tip()
+            push = PushEEFRequest(duration=0.6)
+            push.wrench.force.x = -10.0
+            assert rospy.ServiceProxy("/mujoco_driver/push", PushEEF)(push).success
+            wait_until(lambda: before[0] - tip()[0] > 0.01, 10, "the tool to follow the push along -X")
+            moved = tip() - before
+            assert rospy.ServiceProxy("/contact_control_node/stop", Trigger)().success
+            settle()
+            assert np.all(np.abs(moved[1:]) < 0.25 * abs(moved[0])), f"the follower left the X axis: {moved}"
+            print(f"\n{robot}: jogged 2 cm along -X; the follower gave way to a 10 N push along -X")
+        finally:
+            for c in (pose, joints, cc_status):
+                c.close()
+            twist_pub.unregister()
+        h.stop()
+        assert h.proc.returncode == 0, h.output()[-3000:]
+        assert "escalating" not in h.output(), "a node needed SIGTERM/SIGKILL to stop"
+    wait_until(lambda: not _registered_nodes().intersection(NODES), 10, "the stack's nodes to unregister")
