@@ -171,6 +171,32 @@ def test_force_limit_is_armed_once_the_axis_is_up_to_speed(arm_time, survives):
         assert loop.results[-1].end_conditions[2] == END_FT_VIOLATION
 
 
+def test_force_limit_ignores_the_tool_inertia_when_speeding_up_again_after_a_hold():
+    # A data gap (stale wrench) stops the axis; when data returns it speeds up again, and the tool's
+    # inertia must not end the move then either, while a contact afterwards still does.
+    ctrl = controller(force_limit_arm_time=0.5)
+    loop = ClosedLoop(ctrl)
+    loop.start(laws(x=AxisLaw(LAW_COMPLIANT_MOVE, velocity=-0.05, force_limit=0.5, max_travel=0.5)))
+    previous = [0.0]
+
+    def inertia(t, pose):
+        v = loop.results[-1].velocity[0] if loop.results else 0.0
+        accel, previous[0] = (v - previous[0]) / DT, v
+        return unit(0, -1.0 * accel)
+
+    loop.run(inertia, 1.0)
+    held = ctrl.check_stale(loop.t + 0.5)  # no wrench for 0.5 s: zero output at once
+    assert held is not None and held.velocity[0] == 0.0 and held.move_active
+    loop.results.append(held)
+    loop.t += 0.5
+    previous[0] = 0.0
+    loop.run(inertia, 0.5)
+    assert loop.results[-1].move_active, loop.results[-1].message
+    assert loop.velocities()[-1, 0] == pytest.approx(-0.05)
+    loop.run(wall(loop.pose[0, 3] - 0.005, axis=0, sign=-1.0), 1.0)
+    assert loop.results[-1].end_conditions[0] == END_FT_VIOLATION
+
+
 def test_compliant_move_slows_down_and_ends_at_max_travel():
     loop = ClosedLoop(controller())
     loop.start(laws(x=AxisLaw(LAW_COMPLIANT_MOVE, velocity=0.1, max_travel=0.1)))

@@ -47,7 +47,7 @@ __all__ = ["AxisState", "ContactControl", "CycleResult"]
 
 _ZEROS = (0.0,) * 6
 
-_ARM_SETTLE = 0.1  # [s] at its law's velocity this long before an axis's force limit is armed
+_ARM_SETTLE = 0.1  # [s] after speeding up, before an axis's force limit is checked again
 
 
 class AxisState(NamedTuple):
@@ -157,13 +157,12 @@ class ContactControl:
         self._dt_nominal = 1.0 / s.control_rate
         self._diff = tuple(t.diff_max for t in self._tuning)
         self._windows = [ForceWindow(s.diff_window) for _ in range(6)]
-        # The tool's own inertia while an axis speeds up reads as force on a wrist sensor (1 kg at
-        # 0.5 m/s^2 is 0.5 N), so a small force limit is armed only once the axis has reached its law's
-        # velocity (and held it for _ARM_SETTLE, while the filtered reading settles), or after
-        # force_limit_arm_time.
+        # The tool's own inertia while an axis changes speed reads as force on a wrist sensor (1 kg at
+        # 0.5 m/s^2 is 0.5 N): see _arm.
         self._arm_time = s.force_limit_arm_time
         self._armed = [True] * 6
-        self._at_speed: list[float | None] = [None] * 6
+        self._settled: list[float | None] = [None] * 6
+        self._changing: list[float | None] = [None] * 6
         self._meter = TravelMeter(s.travel_directions)
         self._laws: list[AxisLaw] = [AxisLaw()] * 6
         self._law_types = [LAW_NONE] * 6
@@ -266,7 +265,8 @@ class ContactControl:
             window.clear()
         self._v = [0.0] * 6
         self._armed = [self._arm_time <= 0.0] * 6
-        self._at_speed = [None] * 6
+        self._settled = [None] * 6
+        self._changing = [t] * 6
         self._travel = [0.0] * 6
         self._end = [END_NONE] * 6
         self._ended_axis = -1
@@ -373,22 +373,26 @@ class ContactControl:
         for i in self._active:
             target = law_velocity(laws[i], tuning[i], w[i], travel[i])
             v[i] = shape_velocity(target, v[i], tuning[i], dt)
-            if not armed[i]:
-                armed[i] = self._arm(i, t, v[i] == target)
+            if self._arm_time > 0.0:
+                armed[i] = self._arm(i, t, abs(target) > abs(v[i]) and target * v[i] >= 0.0)
         return self._result(t, SAFETY_OK, "")
 
-    def _arm(self, axis: int, t: float, at_speed: bool) -> bool:
-        """Whether the axis's force limit is checked from now on (see force_limit_arm_time)."""
-        if t - (self._move_t0 or t) >= self._arm_time:
-            return True
-        if not at_speed:
-            self._at_speed[axis] = None
-            return False
-        since = self._at_speed[axis]
-        if since is None:
-            self._at_speed[axis] = t
-            return False
-        return t - since >= min(_ARM_SETTLE, self._arm_time)
+    def _arm(self, axis: int, t: float, speeding_up: bool) -> bool:
+        """Whether the axis's force limit is checked next cycle (see force_limit_arm_time).
+
+        Not while the axis speeds up under its acceleration limit (the tool's inertia reads as force),
+        nor for _ARM_SETTLE after, but never skipped for longer than force_limit_arm_time at a stretch.
+        Slowing down (as a contact does) keeps it checked.
+        """
+        if speeding_up:
+            self._settled[axis] = None
+            if self._changing[axis] is None:
+                self._changing[axis] = t
+            return t - self._changing[axis] >= self._arm_time
+        self._changing[axis] = None
+        if self._settled[axis] is None:
+            self._settled[axis] = t
+        return t - self._settled[axis] >= min(_ARM_SETTLE, self._arm_time)
 
     def check_stale(self, t: float) -> CycleResult | None:
         """Timer check: None while wrenches are fresh, else a zero-output result (SAFETY_STALE).
@@ -442,6 +446,10 @@ class ContactControl:
     def _hold(self, t: float, safety: int, message: str) -> CycleResult:
         self._v = [0.0] * 6
         self._last_t = None  # restart the rate limits from rest
+        if self._arm_time > 0.0:  # stopped at once: the speed-up that follows is a new one
+            self._armed = [False] * 6
+            self._settled = [None] * 6
+            self._changing = [t] * 6
         return self._result(t, safety, message)
 
     def _end_and_hold(self, t: float, axis: int, condition: int) -> CycleResult:
