@@ -47,7 +47,6 @@ __all__ = ["AxisState", "ContactControl", "CycleResult"]
 
 _ZEROS = (0.0,) * 6
 
-_ARM_SETTLE = 0.1  # [s] after speeding up, before an axis's force limit is checked again
 
 
 class AxisState(NamedTuple):
@@ -157,12 +156,11 @@ class ContactControl:
         self._dt_nominal = 1.0 / s.control_rate
         self._diff = tuple(t.diff_max for t in self._tuning)
         self._windows = [ForceWindow(s.diff_window) for _ in range(6)]
-        # The tool's own inertia while an axis changes speed reads as force on a wrist sensor (1 kg at
-        # 0.5 m/s^2 is 0.5 N): see _arm.
+        # The tool's own inertia while the axes speed up from rest reads as force on a wrist sensor (1 kg
+        # at 0.5 m/s^2 is 0.5 N), so force limits are checked from force_limit_arm_time after a start.
         self._arm_time = s.force_limit_arm_time
         self._armed = [True] * 6
-        self._settled: list[float | None] = [None] * 6
-        self._changing: list[float | None] = [None] * 6
+        self._from_rest: float | None = None  # when the axes last started from rest
         self._meter = TravelMeter(s.travel_directions)
         self._laws: list[AxisLaw] = [AxisLaw()] * 6
         self._law_types = [LAW_NONE] * 6
@@ -265,8 +263,7 @@ class ContactControl:
             window.clear()
         self._v = [0.0] * 6
         self._armed = [self._arm_time <= 0.0] * 6
-        self._settled = [None] * 6
-        self._changing = [t] * 6
+        self._from_rest = t
         self._travel = [0.0] * 6
         self._end = [END_NONE] * 6
         self._ended_axis = -1
@@ -371,28 +368,13 @@ class ContactControl:
         self._last_t = t
         v, tuning = self._v, self._tuning
         for i in self._active:
-            target = law_velocity(laws[i], tuning[i], w[i], travel[i])
-            v[i] = shape_velocity(target, v[i], tuning[i], dt)
-            if self._arm_time > 0.0:
-                armed[i] = self._arm(i, t, abs(target) > abs(v[i]) and target * v[i] >= 0.0)
+            v[i] = shape_velocity(law_velocity(laws[i], tuning[i], w[i], travel[i]), v[i], tuning[i], dt)
+        if not all(armed):
+            if self._from_rest is None:
+                self._from_rest = t
+            if t - self._from_rest >= self._arm_time:
+                self._armed = [True] * 6
         return self._result(t, SAFETY_OK, "")
-
-    def _arm(self, axis: int, t: float, speeding_up: bool) -> bool:
-        """Whether the axis's force limit is checked next cycle (see force_limit_arm_time).
-
-        Not while the axis speeds up under its acceleration limit (the tool's inertia reads as force),
-        nor for _ARM_SETTLE after, but never skipped for longer than force_limit_arm_time at a stretch.
-        Slowing down (as a contact does) keeps it checked.
-        """
-        if speeding_up:
-            self._settled[axis] = None
-            if self._changing[axis] is None:
-                self._changing[axis] = t
-            return t - self._changing[axis] >= self._arm_time
-        self._changing[axis] = None
-        if self._settled[axis] is None:
-            self._settled[axis] = t
-        return t - self._settled[axis] >= min(_ARM_SETTLE, self._arm_time)
 
     def check_stale(self, t: float) -> CycleResult | None:
         """Timer check: None while wrenches are fresh, else a zero-output result (SAFETY_STALE).
@@ -446,10 +428,9 @@ class ContactControl:
     def _hold(self, t: float, safety: int, message: str) -> CycleResult:
         self._v = [0.0] * 6
         self._last_t = None  # restart the rate limits from rest
-        if self._arm_time > 0.0:  # stopped at once: the speed-up that follows is a new one
+        if self._arm_time > 0.0:  # stopped at once: the speed-up that follows is a new start
             self._armed = [False] * 6
-            self._settled = [None] * 6
-            self._changing = [t] * 6
+            self._from_rest = t
         return self._result(t, safety, message)
 
     def _end_and_hold(self, t: float, axis: int, condition: int) -> CycleResult:

@@ -63,6 +63,8 @@ class MujocoDriverNode:
         self._base_frame = s.base_frame or urdf_root_link(urdf)
         self._clock_offset = 0.0  # simulated time before the last ~reset, so /clock never runs backwards
         self._publish_every = s.publish_every(sim.dt)
+        self._pose_every = s.eef_pose_every(sim.dt)
+        self._pose_countdown = 1
         self._last_velocity_command = -math.inf  # [s of sim time]
         self._velocity_active = False
         self._zero = np.zeros(len(sim.joint_names))
@@ -226,6 +228,10 @@ class MujocoDriverNode:
         f, t = msg.wrench.force, msg.wrench.torque
         f.x, f.y, f.z, t.x, t.y, t.z = w.tolist()
         self._wrench_pub.publish(msg)
+        self._pose_countdown -= 1
+        if self._pose_countdown > 0:
+            return
+        self._pose_countdown = self._pose_every
         pose = self._pose_msg
         pose.header.stamp = self._stamp
         p, o = pose.pose.position, pose.pose.orientation

@@ -32,7 +32,8 @@ class DriverSettings:
         start_pose: Optional override of the scene's start pose (list in URDF joint order or mapping).
         real_time_factor: Simulated seconds per wall-clock second; 0 = as fast as possible.
         publish_clock: Publish rosgraph_msgs/Clock on /clock and stamp everything with simulated time.
-        publish_period: Period of joint_states, wrench, eef_pose [s]; 0 = every simulation step.
+        publish_period: Period of joint_states and wrench [s]; 0 = every simulation step.
+        eef_pose_period: Period of ~eef_pose [s] (ground truth for plots); 0 = with joint_states.
         command_timeout: Velocity target back to zero this long after the last velocity command [s].
         push_timeout: A ~push_wrench push ends this long after its last message [s].
         max_lag: Largest backlog behind the wall clock caught up without sleeping [s]; more is dropped.
@@ -52,6 +53,7 @@ class DriverSettings:
     real_time_factor: float = 1.0
     publish_clock: bool = False
     publish_period: float = 0.0
+    eef_pose_period: float = 0.01
     command_timeout: float = 0.1
     push_timeout: float = 0.2
     max_lag: float = 0.1
@@ -127,7 +129,7 @@ class DriverSettings:
                 f"~real_time_factor: {self.real_time_factor} runs faster than the wall clock, which needs "
                 "simulated time: set ~publish_clock (or /use_sim_time) true"
             )
-        for key in ("publish_period",):
+        for key in ("publish_period", "eef_pose_period"):
             if getattr(self, key) < 0.0:
                 raise ParamError(f"~{key}: must be >= 0, got {getattr(self, key)}")
         for key in ("command_timeout", "push_timeout", "max_lag", "rtf_period", "viewer_period"):
@@ -140,6 +142,11 @@ class DriverSettings:
         if self.start_pose is not None and not isinstance(self.start_pose, Mapping | list | tuple):
             raise ParamError(f"~start_pose: expected a list (URDF joint order) or a mapping, got "
                              f"{self.start_pose!r}")
+
+    def eef_pose_every(self, dt: float) -> int:
+        """Publications of joint_states between two ~eef_pose (>= 1)."""
+        period = max(self.publish_every(dt) * dt, dt)
+        return max(1, round(self.eef_pose_period / period))
 
     def publish_every(self, dt: float) -> int:
         """Simulation steps between two publications (>= 1)."""

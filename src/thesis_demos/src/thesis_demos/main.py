@@ -17,7 +17,7 @@ def _args(argv: Sequence[str]) -> argparse.Namespace:
     parser.add_argument("--robot", default="robot", help="robot name for the report title")
     parser.add_argument("--only", nargs="*", help="run only these demos (follower_z compliant_move_z ...)")
     parser.add_argument("--sensor-frame", default="ft_sensor")
-    parser.add_argument("--base-frame", default="base_link")
+    parser.add_argument("--base-frame", default="", help="default: contact_control's ~fixed_frame")
     parser.add_argument("--timeout", type=float, default=60.0, help="seconds to wait for the stack")
     return parser.parse_args(argv)
 

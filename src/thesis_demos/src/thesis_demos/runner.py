@@ -35,7 +35,7 @@ class Names:
     contact_control: str = "/contact_control_node"
     driver: str = "/mujoco_driver"
     wrench: str = "/wrench"
-    base_frame: str = "base_link"
+    base_frame: str = ""  # empty: contact_control's ~fixed_frame
 
 
 def build_request(scenario: Scenario) -> ConfigureForceControlRequest:
@@ -114,6 +114,7 @@ class DemoRunner:
         self._reset_safety = rospy.ServiceProxy(f"{cc}/reset", Trigger)
         self._push = rospy.ServiceProxy(f"{drv}/push", PushEEF)
         self._reset_sim = rospy.ServiceProxy(f"{drv}/reset", Trigger)
+        self._base_frame = names.base_frame or rospy.get_param(f"{cc}/fixed_frame", "base_link")
         self._tf = tf2_ros.Buffer()
         self._tf_listener = tf2_ros.TransformListener(self._tf)
         self._pose = _Series(3)
@@ -160,7 +161,7 @@ class DemoRunner:
 
     def _update_sensor_rotation(self, sensor_frame: str) -> None:
         tf = self._tf.lookup_transform(
-            self.names.base_frame, sensor_frame, rospy.Time(0), rospy.Duration(5.0)
+            self._base_frame, sensor_frame, rospy.Time(0), rospy.Duration(5.0)
         )
         q = tf.transform.rotation
         x, y, z, w = q.x, q.y, q.z, q.w

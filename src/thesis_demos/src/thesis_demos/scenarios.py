@@ -55,7 +55,8 @@ class Scenario:
 
 
 # Thesis section 6.4, with the numbers it gives. Where it is silent: pushes of 5 N (follower) and
-# 15 N (spring), V_desired -0.03 m/s (down, onto the obstacle) and -0.05 m/s (X, toward the robot
+# 15 N (spring), V_desired -0.01 m/s (down, onto the obstacle: a usual approach speed for contact,
+# and the contact force grows with it) and -0.05 m/s (X, toward the robot
 # base, where both robots have 0.30 m of clear travel).
 SCENARIOS: tuple[Scenario, ...] = (
     Scenario(
@@ -73,13 +74,13 @@ SCENARIOS: tuple[Scenario, ...] = (
             "z": AxisLaw(
                 COMPLIANT_MOVE,
                 damping=30.0,
-                velocity=-0.03,
+                velocity=-0.01,
                 force_limit=0.5,
                 torque_limit=0.5,
                 max_travel=0.15,
             )
         },
-        duration=8.0,
+        duration=11.0,
         end_when_move_ends=True,
         controlled=("z",),
     ),
