@@ -229,9 +229,9 @@ def test_readme_follower_on_z_matches_the_library_for_a_replayed_bag(fresh, tmp_
     got = [twist_of(m) for m in list(node.twists.msgs)]
     got = got[: next((i for i in range(len(got) - 1, -1, -1) if any(got[i])), 0) + 1]  # drop the stale zeros
     j = 0
-    for (
-        twist
-    ) in got:  # every twist is the library's answer to one wrench, in order (a dropped one is skipped)
+    # Every moving twist is the library's answer to one wrench, in order (a dropped one is skipped); a
+    # zero may also be the node's stale-data hold when the shared machine stalls the replay > 0.1 s.
+    for twist in (t for t in got if any(t)):
         while j < len(expected) and twist != pytest.approx(expected[j], abs=1e-9):
             j += 1
         assert j < len(expected), f"twist {twist} is not the library's output for any later wrench"
