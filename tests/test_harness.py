@@ -82,9 +82,13 @@ def test_run_node_starts_and_stops_a_real_node(ros_node):
     ) as node:
         node.wait_for_topic("/tf_static", timeout=20)
         collector = Collector("/tf_static", TFMessage)
-        msg = collector.wait_for(1)[0]
-        assert msg.transforms[0].child_frame_id == "harness_frame"
-        assert msg.transforms[0].transform.translation.z == 1.0
+
+        def ours():  # /tf_static is latched: other tests' static publishers may answer too
+            transforms = [t for m in list(collector.msgs) for t in m.transforms]
+            return [t for t in transforms if t.child_frame_id == "harness_frame"]
+
+        wait_until(lambda: bool(ours()), 10, "the harness_frame transform")
+        assert ours()[0].transform.translation.z == 1.0
         collector.close()
     assert node.proc.poll() is not None, "node stopped when the context ended"
 

@@ -322,3 +322,45 @@ def test_pinocchio_frame_pose_matches_tf_convention() -> None:
     """The quaternion conversion the node uses for tf frames (x, y, z, w) gives the rotation tf means."""
     quat = pin.Quaternion(math.cos(math.pi / 4), 0.0, 0.0, math.sin(math.pi / 4))  # w, x, y, z
     np.testing.assert_allclose(quat.toRotationMatrix() @ [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], atol=1e-12)
+
+
+def test_publish_on_command_answers_every_twist_without_waiting_for_the_timer(ros_node) -> None:
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import Float64MultiArray
+
+    rospy = ros_node
+    rospy.set_param("/robot_description", UR5.urdf)
+    name = "jog_test_on_command"
+    set_params(
+        rospy,
+        name,
+        {
+            "publish_on_command": True,
+            "pub_period": 2.0,  # the timer alone would give one command per 2 s
+            "command_in_type": "speed_units",
+            "command_out_type": "velocity_array",
+            "integrate_from": "measured",
+            "joint_topic": "/jog_oncmd/joint_states",
+            "cmd_in_topic": "/jog_oncmd/twist",
+            "cmd_out_topic": "/jog_oncmd/command",
+        },
+    )
+    joints = rospy.Publisher("/jog_oncmd/joint_states", JointState, queue_size=1, latch=True)
+    joints.publish(JointState(name=list(ArmModel(UR5.urdf, UR5.tip).joint_names), position=list(UR5.start)))
+    commands = Collector("/jog_oncmd/command", Float64MultiArray)
+    sender = Sender(rospy, "/jog_oncmd/twist")
+    with run_node("jog_arm", "jog_arm_server", name=name) as node, node_log_on_failure(node):
+        node.wait_for_topic("/jog_oncmd/command")
+        try:
+            wait_until(lambda: sender.pub.get_num_connections() > 0, 20, "jog_arm_server subscribed")
+            commands.wait_connected()
+            commands.clear()
+            sender.start(twist_msg((0.0, 0.0, 0.05, 0.0, 0.0, 0.0)), rate=50.0)
+            commands.wait_for(20, timeout=5)  # ~50 per second, where the 2 s timer alone gives 2 or 3
+            model = ArmModel(UR5.urdf, UR5.tip)
+            v = eef_velocity(model, UR5.start, commands.last().data)
+            assert v[2] > 0.0 and abs(v[0]) < 0.2 * v[2] and abs(v[1]) < 0.2 * v[2]
+        finally:
+            sender.stop()
+            commands.close()
+            joints.unregister()

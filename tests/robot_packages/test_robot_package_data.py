@@ -87,9 +87,10 @@ def test_sim_stack_is_wired_driver_contact_control_jog_arm_driver(robot):
                                                                        "/contact_control_node")
     assert resolve(cc["velocity_out_topic"], "/contact_control_node") == resolve(jog["cmd_in_topic"],
                                                                                 "/jog_arm_server")
-    assert resolve(jog["cmd_out_topic"], "/jog_arm_server") == resolve(driver["trajectory_command_topic"],
+    # Velocities into the driver's velocity input (see the robot README: no trajectory restarts).
+    assert resolve(jog["cmd_out_topic"], "/jog_arm_server") == resolve(driver["velocity_command_topic"],
                                                                       "/mujoco_driver")
-    assert jog["command_out_type"] == "trajectory"
+    assert jog["command_out_type"] == "velocity_array"
     assert resolve(jog["joint_topic"], "/jog_arm_server") == resolve(driver["joint_states_topic"],
                                                                     "/mujoco_driver")
     assert jog["command_in_type"] == "speed_units"  # contact_control sends m/s

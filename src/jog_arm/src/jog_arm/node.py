@@ -9,6 +9,7 @@ frames; frames tf does not have either are refused with a warning.
 from __future__ import annotations
 
 import gc
+import math
 import sys
 import threading
 from typing import Any
@@ -54,6 +55,7 @@ class JogArmNode:
         self._tf_listener = tf2_ros.TransformListener(self._tf_buffer)
         self._frames_ready: set[str] = set()  # command frames known to be usable (model, or tf looked up)
         self._last_status = StatusCode.NO_JOINT_STATE
+        self._last_cycle = -math.inf
         self._cycles = CycleMonitor(settings.pub_period)
         names = list(self._jog.joint_names)
         self._joint_set = frozenset(names)
@@ -115,6 +117,8 @@ class JogArmNode:
             result = self._jog.set_command(twist, frame, now)
         if not result.accepted:
             rospy.logwarn_throttle(_WARN_PERIOD, f"jog_arm_server: command refused: {result.reason}")
+        elif self._s.publish_on_command:
+            self._cycle(now)
 
     def _ensure_frame(self, frame: str) -> None:
         """Makes a frame tf knows but the model does not usable (looked up once, then cached)."""
@@ -145,6 +149,13 @@ class JogArmNode:
 
     def _on_timer(self, _event: rospy.timer.TimerEvent) -> None:
         now = rospy.get_time()
+        if self._s.publish_on_command and now - self._last_cycle < 0.5 * self._s.pub_period:
+            return  # a command just ran this cycle
+        self._cycle(now)
+
+    def _cycle(self, now: float) -> None:
+        """One control cycle: compute, publish the joint command and the status."""
+        self._last_cycle = now
         if self._cycles.tick(now):
             rospy.logwarn_throttle(
                 10.0,

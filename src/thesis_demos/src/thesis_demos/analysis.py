@@ -20,7 +20,7 @@ AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 # stop has gone through jog_arm and the joint servos, the tool keeps closing in at V_desired (0.01 m/s)
 # for some 30-50 ms, i.e. ~0.5 mm into a hard obstacle, at the servo's Cartesian stiffness of ~20 N/mm.
 # The bound must stay under contact_control's 25 N global limit, so that the move ends by its own law
-# and never by the safety latch; a cobot's own protective stop is far higher (150 N on the UR5).
+# and never by the safety latch; a cobot's own protective stop is far higher (around 150 N).
 CONTACT_FORCE_BOUND = 20.0
 
 
