@@ -25,6 +25,7 @@ demo: build
 bench: build
 	@$(ENV) python scripts/bench_contact_control
 	@$(ENV) python scripts/bench_jog_arm
+	@$(ENV) python scripts/bench_sim_stack --robot $(ROBOT)
 
 clean:
 	rm -rf build devel .bootstrap/build.log

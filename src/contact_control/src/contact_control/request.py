@@ -38,6 +38,7 @@ __all__ = [
     "SUCCESS",
     "RequestError",
     "RequestLimits",
+    "axis_groups",
     "empty_request",
     "fill_request",
     "validate_request",
@@ -82,25 +83,33 @@ class RequestLimits:
         )
 
 
-def _fields(req: Any, axis: int) -> tuple[int, float, float, float, float, float]:
-    p = req.cart_impedance_params
-    c = AXES[axis][-1]
+def axis_groups(params: Any, axis: int) -> tuple[Any, Any, Any, Any, Any]:
+    """The five Vector3 of `cart_impedance_params` an axis reads (b, k, V_desired, limit, max travel).
+
+    Args:
+        params: a request's `cart_impedance_params`.
+        axis: 0..5 for x, y, z, rx, ry, rz; read or write component `AXES[axis][-1]` of each.
+    """
     if axis < 3:
-        groups = (
-            p.damping.translational,
-            p.stiffness.translational,
-            p.max_cart_vel.set.linear,
-            p.max_ctrl_force.set.force,
-            p.max_path_deviation.translation,
+        return (
+            params.damping.translational,
+            params.stiffness.translational,
+            params.max_cart_vel.set.linear,
+            params.max_ctrl_force.set.force,
+            params.max_path_deviation.translation,
         )
-    else:
-        groups = (
-            p.damping.rotational,
-            p.stiffness.rotational,
-            p.max_cart_vel.set.angular,
-            p.max_ctrl_force.set.torque,
-            p.max_path_deviation.rotation,
-        )
+    return (
+        params.damping.rotational,
+        params.stiffness.rotational,
+        params.max_cart_vel.set.angular,
+        params.max_ctrl_force.set.torque,
+        params.max_path_deviation.rotation,
+    )
+
+
+def _fields(req: Any, axis: int) -> tuple[int, float, float, float, float, float]:
+    c = AXES[axis][-1]
+    groups = axis_groups(req.cart_impedance_params, axis)
     law = getattr(req.direction_control_laws, AXES[axis]).type
     b, k, v, limit, travel = (float(getattr(g, c)) for g in groups)
     return int(law), b, k, v, limit, travel
@@ -214,22 +223,7 @@ def fill_request(req: Any, laws: Sequence[AxisLaw]) -> Any:
     p = req.cart_impedance_params
     for axis, law in enumerate(laws):
         c = AXES[axis][-1]
-        if axis < 3:
-            groups = (
-                p.damping.translational,
-                p.stiffness.translational,
-                p.max_cart_vel.set.linear,
-                p.max_ctrl_force.set.force,
-                p.max_path_deviation.translation,
-            )
-        else:
-            groups = (
-                p.damping.rotational,
-                p.stiffness.rotational,
-                p.max_cart_vel.set.angular,
-                p.max_ctrl_force.set.torque,
-                p.max_path_deviation.rotation,
-            )
+        groups = axis_groups(p, axis)
         values = (law.damping, law.stiffness, law.velocity, law.force_limit, law.max_travel)
         for group, value in zip(groups, values, strict=True):
             setattr(group, c, float(value))

@@ -24,6 +24,8 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass, replace
 from typing import Any
 
+from contact_control.request import axis_groups
+
 from manipulator_control_gui.form_config import (
     AXES,
     AXIS_LABELS,
@@ -31,7 +33,6 @@ from manipulator_control_gui.form_config import (
     LAW_FIELDS,
     LAWS,
     GuiConfig,
-    is_angular,
 )
 
 __all__ = [
@@ -197,22 +198,7 @@ def write_request(form: Mapping[str, AxisForm], req: Any) -> Any:
         row = form[axis]
         used = LAW_FIELDS[row.law]
         values = [getattr(row, f) if f in used else 0.0 for f in FIELDS]
-        if is_angular(axis):
-            groups = (
-                p.damping.rotational,
-                p.stiffness.rotational,
-                p.max_cart_vel.set.angular,
-                p.max_ctrl_force.set.torque,
-                p.max_path_deviation.rotation,
-            )
-        else:
-            groups = (
-                p.damping.translational,
-                p.stiffness.translational,
-                p.max_cart_vel.set.linear,
-                p.max_ctrl_force.set.force,
-                p.max_path_deviation.translation,
-            )
+        groups = axis_groups(p, AXES.index(axis))
         component = axis[-1]
         for group, value in zip(groups, values, strict=True):
             setattr(group, component, float(value))
