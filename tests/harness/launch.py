@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import contextlib
 import os
-import signal
 import subprocess
 import tempfile
 import xmlrpc.client
 from collections.abc import Iterator, Mapping, Sequence
 
+from harness.process import stop_process_group
 from harness.waiting import wait_until
 
 __all__ = ["Launched", "run_launch", "run_node"]
@@ -55,16 +55,7 @@ class Launched:
         wait_until(registered, timeout, f"service {name}\n{self.output()[-4000:]}")
 
     def stop(self, timeout: float = 15.0) -> None:
-        if self.proc.poll() is not None:
-            return
-        with contextlib.suppress(ProcessLookupError):
-            os.killpg(self.proc.pid, signal.SIGINT)
-        try:
-            self.proc.wait(timeout=timeout)
-        except subprocess.TimeoutExpired:
-            with contextlib.suppress(ProcessLookupError):
-                os.killpg(self.proc.pid, signal.SIGKILL)
-            self.proc.wait()
+        stop_process_group(self.proc, timeout)
 
 
 @contextlib.contextmanager

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import contextlib
 import os
-import signal
 import socket
 import subprocess
 import time
 import xmlrpc.client
+
+from harness.process import stop_process_group
 
 __all__ = ["Master", "free_port", "start_master"]
 
@@ -42,14 +42,7 @@ class Master:
         return code == 1
 
     def stop(self) -> None:
-        if self.proc.poll() is None:
-            with contextlib.suppress(ProcessLookupError):
-                os.killpg(self.proc.pid, signal.SIGINT)
-            try:
-                self.proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                os.killpg(self.proc.pid, signal.SIGKILL)
-                self.proc.wait()
+        stop_process_group(self.proc)
 
 
 def master_env(port: int, base: dict[str, str] | None = None) -> dict[str, str]:

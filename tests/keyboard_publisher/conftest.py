@@ -5,13 +5,13 @@ from __future__ import annotations
 import contextlib
 import os
 import select
-import signal
 import subprocess
 import termios
 import threading
 from collections.abc import Iterator, Sequence
 
 import pytest
+from harness.process import stop_process_group
 from harness.waiting import wait_until
 
 
@@ -81,15 +81,7 @@ class PtyProcess:
             raise AssertionError(f"still running after {timeout} s:\n{self.output()[-3000:]}") from err
 
     def close(self) -> None:
-        if self.proc.poll() is None:
-            with contextlib.suppress(ProcessLookupError):
-                os.killpg(self.proc.pid, signal.SIGINT)
-            try:
-                self.proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                with contextlib.suppress(ProcessLookupError):
-                    os.killpg(self.proc.pid, signal.SIGKILL)
-                self.proc.wait()
+        stop_process_group(self.proc)
         self._done.set()
         self._thread.join(timeout=5)
         os.close(self.master)
