@@ -1,5 +1,6 @@
 # One entry point for users and CI. `make demo` and `make test` bootstrap what they need.
 SHELL := /bin/bash
+.SHELLFLAGS := -o pipefail -c
 ROBOT ?= ur5
 ENV := scripts/with_env
 PYTEST_ARGS ?=
