@@ -277,45 +277,45 @@ def test_invalid_configuration_refuses_to_start(ros_node) -> None:
         assert f"/{name}/hard_stop_singularity_threshold" in node.output()
 
 
-def test_simu_mode_sends_several_points(ros_node) -> None:
+@contextlib.contextmanager
+def ur5_server(rospy, name: str, prefix: str, params: dict, out_class: type):
+    """jog_arm_server for the UR5 at its start pose on `prefix` topics: yields (commands, twist sender)."""
     from sensor_msgs.msg import JointState
-    from trajectory_msgs.msg import JointTrajectory
 
-    rospy = ros_node
     rospy.set_param("/robot_description", UR5.urdf)
-    name = "jog_test_simu"
-    set_params(
-        rospy,
-        name,
-        {
-            "simu": True,
-            "simu_points": 3,
-            "pub_period": 0.005,
-            "command_in_type": "speed_units",
-            "joint_topic": "/jog_simu/joint_states",
-            "cmd_in_topic": "/jog_simu/twist",
-            "cmd_out_topic": "/jog_simu/command",
-        },
-    )
-    joints = rospy.Publisher("/jog_simu/joint_states", JointState, queue_size=1, latch=True)
+    topics = {
+        "joint_topic": f"{prefix}/joint_states",
+        "cmd_in_topic": f"{prefix}/twist",
+        "cmd_out_topic": f"{prefix}/command",
+    }
+    set_params(rospy, name, {"command_in_type": "speed_units", **topics, **params})
+    joints = rospy.Publisher(topics["joint_topic"], JointState, queue_size=1, latch=True)
     joints.publish(JointState(name=list(ArmModel(UR5.urdf, UR5.tip).joint_names), position=list(UR5.start)))
-    commands = Collector("/jog_simu/command", JointTrajectory)
-    sender = Sender(rospy, "/jog_simu/twist")
+    commands = Collector(topics["cmd_out_topic"], out_class)
+    sender = Sender(rospy, topics["cmd_in_topic"])
     with run_node("jog_arm", "jog_arm_server", name=name) as node, node_log_on_failure(node):
-        node.wait_for_topic("/jog_simu/command")
+        node.wait_for_topic(topics["cmd_out_topic"])
         try:
             wait_until(lambda: sender.pub.get_num_connections() > 0, 20, "jog_arm_server subscribed")
-            sender.start(twist_msg((0.0, 0.0, 0.05, 0.0, 0.0, 0.0)))
-            msg = commands.wait_for(10, timeout=10)[-1]
-            times = [p.time_from_start.to_sec() for p in msg.points]
-            assert times == pytest.approx([0.005, 0.010, 0.015])
-            q = [np.array(p.positions) for p in msg.points]
-            v = np.array(msg.points[0].velocities)
-            np.testing.assert_allclose(q[2] - q[1], v * 0.005, atol=1e-12)  # extrapolated at the velocity
+            yield commands, sender
         finally:
             sender.stop()
             commands.close()
             joints.unregister()
+
+
+def test_simu_mode_sends_several_points(ros_node) -> None:
+    from trajectory_msgs.msg import JointTrajectory
+
+    params = {"simu": True, "simu_points": 3, "pub_period": 0.005}
+    with ur5_server(ros_node, "jog_test_simu", "/jog_simu", params, JointTrajectory) as (commands, sender):
+        sender.start(twist_msg((0.0, 0.0, 0.05, 0.0, 0.0, 0.0)))
+        msg = commands.wait_for(10, timeout=10)[-1]
+        times = [p.time_from_start.to_sec() for p in msg.points]
+        assert times == pytest.approx([0.005, 0.010, 0.015])
+        q = [np.array(p.positions) for p in msg.points]
+        v = np.array(msg.points[0].velocities)
+        np.testing.assert_allclose(q[2] - q[1], v * 0.005, atol=1e-12)  # extrapolated at the velocity
 
 
 def test_pinocchio_frame_pose_matches_tf_convention() -> None:
@@ -325,42 +325,21 @@ def test_pinocchio_frame_pose_matches_tf_convention() -> None:
 
 
 def test_publish_on_command_answers_every_twist_without_waiting_for_the_timer(ros_node) -> None:
-    from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
 
-    rospy = ros_node
-    rospy.set_param("/robot_description", UR5.urdf)
-    name = "jog_test_on_command"
-    set_params(
-        rospy,
-        name,
-        {
-            "publish_on_command": True,
-            "pub_period": 2.0,  # the timer alone would give one command per 2 s
-            "command_in_type": "speed_units",
-            "command_out_type": "velocity_array",
-            "integrate_from": "measured",
-            "joint_topic": "/jog_oncmd/joint_states",
-            "cmd_in_topic": "/jog_oncmd/twist",
-            "cmd_out_topic": "/jog_oncmd/command",
-        },
-    )
-    joints = rospy.Publisher("/jog_oncmd/joint_states", JointState, queue_size=1, latch=True)
-    joints.publish(JointState(name=list(ArmModel(UR5.urdf, UR5.tip).joint_names), position=list(UR5.start)))
-    commands = Collector("/jog_oncmd/command", Float64MultiArray)
-    sender = Sender(rospy, "/jog_oncmd/twist")
-    with run_node("jog_arm", "jog_arm_server", name=name) as node, node_log_on_failure(node):
-        node.wait_for_topic("/jog_oncmd/command")
-        try:
-            wait_until(lambda: sender.pub.get_num_connections() > 0, 20, "jog_arm_server subscribed")
-            commands.wait_connected()
-            commands.clear()
-            sender.start(twist_msg((0.0, 0.0, 0.05, 0.0, 0.0, 0.0)), rate=50.0)
-            commands.wait_for(20, timeout=5)  # ~50 per second, where the 2 s timer alone gives 2 or 3
-            model = ArmModel(UR5.urdf, UR5.tip)
-            v = eef_velocity(model, UR5.start, commands.last().data)
-            assert v[2] > 0.0 and abs(v[0]) < 0.2 * v[2] and abs(v[1]) < 0.2 * v[2]
-        finally:
-            sender.stop()
-            commands.close()
-            joints.unregister()
+    params = {
+        "publish_on_command": True,
+        "pub_period": 2.0,  # the timer alone would give one command per 2 s
+        "command_out_type": "velocity_array",
+        "integrate_from": "measured",
+    }
+    with ur5_server(ros_node, "jog_test_on_command", "/jog_oncmd", params, Float64MultiArray) as (
+        commands,
+        sender,
+    ):
+        commands.wait_connected()
+        commands.clear()
+        sender.start(twist_msg((0.0, 0.0, 0.05, 0.0, 0.0, 0.0)), rate=50.0)
+        commands.wait_for(20, timeout=5)  # ~50 per second, where the 2 s timer alone gives 2 or 3
+        v = eef_velocity(ArmModel(UR5.urdf, UR5.tip), UR5.start, commands.last().data)
+        assert v[2] > 0.0 and abs(v[0]) < 0.2 * v[2] and abs(v[1]) < 0.2 * v[2]
