@@ -396,3 +396,40 @@ def test_config_file_documents_every_parameter_with_its_default():
     data = yaml.safe_load((PKG / "config" / "contact_control.yaml").read_text())
     assert set(PARAMETERS) - set(data) == {"max_angular_velocity"}  # commented out: defaults to max_velocity
     assert load_settings(data) == load_settings({})
+
+
+def test_queued_publishing_mode_still_answers_each_push_with_a_follower_twist(ros_node):
+    """publish_synchronously: false (rospy's sender thread) must behave as the default does."""
+    import rospy
+    from cartesian_impedance_msgs.srv import ConfigureForceControlRequest
+
+    ns = "/cc_queued"
+    params = {
+        "~ft_in_topic": "wrench", "~velocity_out_topic": "ee_velocity", "~publish_synchronously": False,
+        "~tare_on_startup": False, "~lp_filter_enabled": False, "~wrench_timeout": 0.5,
+    }
+    with run_node("contact_control", "contact_control_node", args=[f"__ns:={ns}"], params=params) as h:
+        h.wait_for_service(f"{ns}/configure_cartesian_impedance")
+        pub = ros_node.Publisher(f"{ns}/wrench", WrenchStamped, queue_size=10, tcp_nodelay=True)
+        twists = Collector(f"{ns}/ee_velocity", TwistStamped)
+        try:
+            wait_until(lambda: pub.get_num_connections() > 0, 10, "the node to subscribe to the wrench")
+            req = ConfigureForceControlRequest()
+            req.direction_control_laws.z.type = 1  # follower
+            req.cart_impedance_params.damping.translational.z = 30.0
+            configure = rospy.ServiceProxy(f"{ns}/configure_cartesian_impedance", ConfigureForceControl)
+            assert configure(req).success
+            msg = WrenchStamped()
+            msg.header.frame_id = "base_link"
+            msg.wrench.force.z = -6.0
+
+            def pushed_down() -> bool:
+                msg.header.stamp = rospy.Time.now()
+                pub.publish(msg)
+                return any(m.twist.linear.z < -0.01 for m in list(twists.msgs))
+
+            wait_until(pushed_down, 10, "a downward twist for a downward push")
+            assert all(abs(m.twist.linear.x) < 1e-9 and m.twist.linear.z <= 0.0 for m in list(twists.msgs))
+        finally:
+            twists.close()
+            pub.unregister()

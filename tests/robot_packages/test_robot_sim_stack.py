@@ -27,7 +27,7 @@ TOPICS = ("/joint_states", "/wrench", "/tf", "/mujoco_driver/eef_pose")
 SERVICES = ("/configure_cartesian_impedance", "/configure_cartesian_impedance_blocking",
             "/contact_control_node/tare", "/contact_control_node/stop", "/jog_arm_server/pause",
             "/mujoco_driver/push", "/mujoco_driver/reset")
-NODES = ("/mujoco_driver", "/jog_arm_server", "/contact_control_node", "/robot_state_publisher")
+NODES = ("/mujoco_driver", "/control_stack", "/jog_arm_server", "/contact_control_node", "/robot_state_publisher")
 
 
 def _registered_nodes() -> set[str]:
@@ -36,10 +36,11 @@ def _registered_nodes() -> set[str]:
     return {node for kind in state for _, nodes in kind for node in nodes}
 
 
-@pytest.mark.parametrize("robot", sorted(BASE_FRAME))
-def test_sim_stack_comes_up_jogs_follows_a_push_and_shuts_down(ros_node, robot):
+# The demos run both robots in one process (the default); here each robot also runs the other layout.
+@pytest.mark.parametrize("robot, single_process", [("panda_custom", False), ("ur5_custom", True)])
+def test_sim_stack_comes_up_jogs_follows_a_push_and_shuts_down(ros_node, robot, single_process):
     rospy = ros_node
-    with run_launch(robot, "sim.launch") as h:
+    with run_launch(robot, "sim.launch", args={"single_process": str(single_process).lower()}) as h:
         for topic in TOPICS:
             h.wait_for_topic(topic, timeout=40)
         for service in SERVICES:

@@ -10,9 +10,10 @@ topic in between.
 from __future__ import annotations
 
 import contextlib
+import gc
 import sys
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import rospy
@@ -38,16 +39,28 @@ from contact_control.params import PARAMETERS, ContactControlSettings, ParamErro
 from contact_control.preprocess import PreprocessError
 from contact_control.request import RequestError, RequestLimits, validate_request
 
-__all__ = ["ContactControlNode", "main"]
+__all__ = ["ContactControlNode", "main", "read_settings", "tune_runtime"]
 
 _ZERO = (0.0,) * 6
 _TF_ERRORS = (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException)
 
 
 class ContactControlNode:
-    """Topics, services, tf and timers around one `ContactControl`; every call into it holds `_lock`."""
+    """Topics, services, tf and timers around one `ContactControl`; every call into it holds `_lock`.
 
-    def __init__(self, settings: ContactControlSettings) -> None:
+    Args:
+        settings: Validated parameters.
+        private_ns: Prefix of the private topics and services: "~" in a node of its own,
+            "/contact_control_node/" when sharing a process (control_stack).
+        twist_sink: Called with each twist before it is published (same process: no hop).
+    """
+
+    def __init__(
+        self,
+        settings: ContactControlSettings,
+        private_ns: str = "~",
+        twist_sink: Callable[[TwistStamped], None] | None = None,
+    ) -> None:
         s = self._s = settings
         self._ctrl = ContactControl(settings)
         self._limits = RequestLimits.from_settings(settings)
@@ -61,19 +74,27 @@ class ContactControlNode:
         self._idle_zeros = 0
         self._was_active = False
         self._request_note = ""
+        self._twist_sink = twist_sink
         self._twist = TwistStamped()
         self._twist.header.frame_id = s.velocity_command_frame
-        self._twist_pub = rospy.Publisher(s.velocity_out_topic, TwistStamped, queue_size=1, tcp_nodelay=True)
-        self._status_pub = rospy.Publisher("~status", ContactControlStatus, queue_size=10)
+        # Synchronous: the twist leaves in the wrench callback, ~90 us sooner than through rospy's sender
+        # thread. A subscriber that stops reading then blocks this node, and jog_arm halts on its timeout.
+        queue = None if s.publish_synchronously else 1
+        self._twist_pub = rospy.Publisher(
+            s.velocity_out_topic, TwistStamped, queue_size=queue, tcp_nodelay=True
+        )
+        self._status_pub = rospy.Publisher(private_ns + "status", ContactControlStatus, queue_size=10)
+        self._status_msg = ContactControlStatus(axes=[AxisState(axis=name) for name in AXES])
+        self._status_msg.header.frame_id = s.control_frame
         # Service names in the node's namespace (not private), as the original served them.
         self._services = [
             rospy.Service("configure_cartesian_impedance", ConfigureForceControl, self._on_configure),
             rospy.Service(
                 "configure_cartesian_impedance_blocking", ConfigureForceControl, self._on_configure_blocking
             ),
-            rospy.Service("~tare", Trigger, self._on_tare),
-            rospy.Service("~stop", Trigger, self._on_stop),
-            rospy.Service("~reset", Trigger, self._on_reset),
+            rospy.Service(private_ns + "tare", Trigger, self._on_tare),
+            rospy.Service(private_ns + "stop", Trigger, self._on_stop),
+            rospy.Service(private_ns + "reset", Trigger, self._on_reset),
         ]
         self._sub = rospy.Subscriber(
             s.ft_in_topic, WrenchStamped, self._on_wrench, queue_size=1, tcp_nodelay=True
@@ -88,7 +109,8 @@ class ContactControlNode:
         cached = self._static.get(frame)
         if cached is not None:
             return cached
-        msg = self._buffer.lookup_transform(self._s.fixed_frame, frame, self._time0)
+        # The core call: Buffer.lookup_transform adds a can_transform round trip (~4 us) that only waits.
+        msg = self._buffer.lookup_transform_core(self._s.fixed_frame, frame, self._time0)
         t, q = msg.transform.translation, msg.transform.rotation
         pose = transform((t.x, t.y, t.z), (q.x, q.y, q.z, q.w))
         if msg.header.stamp.is_zero():  # tf2 answers time 0 only when every link of the chain is static
@@ -168,6 +190,8 @@ class ContactControlNode:
         tw.header.stamp = rospy.Time.now()
         lin, ang = tw.twist.linear, tw.twist.angular
         lin.x, lin.y, lin.z, ang.x, ang.y, ang.z = velocity
+        if self._twist_sink is not None:
+            self._twist_sink(tw)
         self._twist_pub.publish(tw)
 
     # --- services ---
@@ -238,9 +262,8 @@ class ContactControlNode:
         with self._lock:
             r = self._ctrl.last_result
             note = self._request_note
-        msg = ContactControlStatus()
+        msg = self._status_msg  # reused: the status timer allocates nothing per cycle
         msg.header.stamp = rospy.Time.now()
-        msg.header.frame_id = self._s.control_frame
         msg.move_active = r.move_active
         msg.safety = r.safety
         msg.message = "; ".join(m for m in (r.message, note) if m)
@@ -249,13 +272,9 @@ class ContactControlNode:
         f.x, f.y, f.z, q.x, q.y, q.z = w
         lin, ang = msg.velocity.linear, msg.velocity.angular
         lin.x, lin.y, lin.z, ang.x, ang.y, ang.z = v
-        msg.axes = [
-            AxisState(
-                axis=AXES[i], law=r.laws[i], end_condition=r.end_conditions[i], force=w[i], velocity=v[i],
-                travel=r.travel[i],
-            )
-            for i in range(6)
-        ]
+        for i, axis in enumerate(msg.axes):
+            axis.law, axis.end_condition = r.laws[i], r.end_conditions[i]
+            axis.force, axis.velocity, axis.travel = w[i], v[i], r.travel[i]
         self._status_pub.publish(msg)
 
     def _on_shutdown(self) -> None:
@@ -266,18 +285,37 @@ class ContactControlNode:
                     self._send(_ZERO)
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of `rosrun contact_control contact_control_node`."""
-    rospy.init_node("contact_control_node", argv=list(sys.argv if argv is None else argv))
+def read_settings(param_ns: str = "~") -> ContactControlSettings | None:
+    """Settings from the parameter server; logs why and returns None when they are invalid."""
     try:
-        settings = load_settings(rospy.get_param("~", {}))
+        settings = load_settings(rospy.get_param(param_ns, {}))
     except ParamError as err:
         rospy.logfatal("contact_control_node: bad configuration, not starting: %s", err)
-        return 1
+        return None
     if settings.unknown_keys:
         rospy.logwarn("contact_control_node: ignoring unknown parameters %s (known: see the README)",
                       ", ".join(settings.unknown_keys))
+    return settings
+
+
+def tune_runtime(period: float) -> None:
+    """Keeps the interpreter from delaying the control threads (call once, after start-up)."""
+    # A thread waiting for the GIL can wait a whole switch interval (5 ms by default) for a busy one: keep it
+    # well below the control period so a message is handled on arrival.
+    sys.setswitchinterval(min(sys.getswitchinterval(), period / 10.0))
+    # Start-up objects never die; a full collection over them stalls a cycle for ~15 ms.
+    gc.collect()
+    gc.freeze()
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of `rosrun contact_control contact_control_node`."""
+    rospy.init_node("contact_control_node", argv=list(sys.argv if argv is None else argv))
+    settings = read_settings()
+    if settings is None:
+        return 1
     ContactControlNode(settings)
+    tune_runtime(1.0 / settings.control_rate)
     rospy.loginfo(
         "contact_control_node: wrench in %s, twist out %s (%s), control frame %s, %d parameters loaded",
         rospy.resolve_name(settings.ft_in_topic), rospy.resolve_name(settings.velocity_out_topic),

@@ -42,6 +42,7 @@ PARAMETERS: dict[str, tuple[str, Any, str, str]] = {
     "check_stamp_age": ("bool", True, "", "wrenches stamped more than wrench_timeout ago are stale"),
     "publish_when_idle": ("bool", False, "", "publish zero twists when no move is active"),
     "idle_zero_count": ("nonneg", 10.0, "", "zero twists sent after a move ends, then silence"),
+    "publish_synchronously": ("bool", True, "", "send the twist from the wrench callback, no sender thread"),
     # wrench preprocessing
     "lp_filter_enabled": ("bool", True, "", "second-order Butterworth low-pass on the wrench"),
     "lp_filter_delta_t": ("pos", 0.2, "s", "design sample period (the filter steps once per wrench)"),
@@ -124,6 +125,7 @@ class ContactControlSettings:
     check_stamp_age: bool = True
     publish_when_idle: bool = False
     idle_zero_count: float = 10.0
+    publish_synchronously: bool = True
     lp_filter_enabled: bool = True
     lp_filter_delta_t: float = 0.2
     lp_filter_cutoff_freq: float = 0.6

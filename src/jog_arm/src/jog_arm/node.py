@@ -30,10 +30,13 @@ from jog_arm.settings import JogSettings, SettingsError
 from jog_arm.status import StatusCode
 from jog_arm.timing import CycleMonitor
 
-__all__ = ["JogArmNode", "main"]
+__all__ = ["JogArmNode", "main", "start"]
 
 _TF_ERRORS = (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException)
 _WARN_PERIOD = 2.0  # [s] throttle of repeated warnings
+# publish_on_command: the timer runs a cycle only when none ran for this many periods. Above 1, so twists
+# arriving once per period never get an extra timer cycle between them (a duplicate command, older data).
+_FILL_AFTER = 1.25
 
 
 class JogArmNode:
@@ -42,15 +45,22 @@ class JogArmNode:
     Args:
         settings: Validated parameters.
         urdf_xml: The robot description.
+        private_ns: Prefix of the private topics and services: "~" in a node of its own,
+            "/jog_arm_server/" when sharing a process (control_stack).
+        skip_callerid: Twists from this publisher (the process itself) arrive through `accept_twist`,
+            so their copies on the topic are dropped.
 
     Raises:
         KinematicsError, SettingsError: The configuration does not fit the robot model.
     """
 
-    def __init__(self, settings: JogSettings, urdf_xml: str) -> None:
+    def __init__(
+        self, settings: JogSettings, urdf_xml: str, private_ns: str = "~", skip_callerid: str | None = None
+    ) -> None:
         self._s = settings
         self._jog = JogCalcs(settings, urdf_xml)
         self._lock = threading.Lock()
+        self._pub_lock = threading.Lock()
         self._tf_buffer = tf2_ros.Buffer()
         self._tf_listener = tf2_ros.TransformListener(self._tf_buffer)
         self._frames_ready: set[str] = set()  # command frames known to be usable (model, or tf looked up)
@@ -60,23 +70,25 @@ class JogArmNode:
         names = list(self._jog.joint_names)
         self._joint_set = frozenset(names)
         self._points = settings.simu_points if settings.simu else 1
+        queue = None if settings.publish_synchronously else 1  # None: no sender thread, see the README
         if settings.command_out_type == "trajectory":
             self._cmd_msg: Any = JointTrajectory(joint_names=names)
             self._cmd_pub = rospy.Publisher(
-                settings.cmd_out_topic, JointTrajectory, queue_size=1, tcp_nodelay=True
+                settings.cmd_out_topic, JointTrajectory, queue_size=queue, tcp_nodelay=True
             )
         else:
             self._cmd_msg = Float64MultiArray()
             self._cmd_pub = rospy.Publisher(
-                settings.cmd_out_topic, Float64MultiArray, queue_size=1, tcp_nodelay=True
+                settings.cmd_out_topic, Float64MultiArray, queue_size=queue, tcp_nodelay=True
             )
         self._status_msg = JogStatus()
-        self._status_pub = rospy.Publisher("~status", JogStatus, queue_size=100)
+        self._status_pub = rospy.Publisher(private_ns + "status", JogStatus, queue_size=100)
         self._services = [
-            rospy.Service("~pause", Trigger, self._on_pause),
-            rospy.Service("~resume", Trigger, self._on_resume),
-            rospy.Service("~cycle_stats", Trigger, self._on_cycle_stats),
+            rospy.Service(private_ns + "pause", Trigger, self._on_pause),
+            rospy.Service(private_ns + "resume", Trigger, self._on_resume),
+            rospy.Service(private_ns + "cycle_stats", Trigger, self._on_cycle_stats),
         ]
+        self._skip_callerid = skip_callerid
         fast = {"queue_size": 1, "tcp_nodelay": True}
         self._subs = [
             rospy.Subscriber(settings.joint_topic, JointState, self._on_joints, **fast),
@@ -108,6 +120,13 @@ class JogArmNode:
             )
 
     def _on_twist(self, msg: TwistStamped) -> None:
+        header = getattr(msg, "_connection_header", None)
+        if self._skip_callerid is not None and header and header.get("callerid") == self._skip_callerid:
+            return  # already handed over in-process
+        self.accept_twist(msg)
+
+    def accept_twist(self, msg: TwistStamped) -> None:
+        """A velocity command, from the topic or from a controller in the same process."""
         now = rospy.get_time()
         frame = msg.header.frame_id.lstrip("/")
         self._ensure_frame(frame or self._s.default_cmd_frame)
@@ -149,8 +168,8 @@ class JogArmNode:
 
     def _on_timer(self, _event: rospy.timer.TimerEvent) -> None:
         now = rospy.get_time()
-        if self._s.publish_on_command and now - self._last_cycle < 0.5 * self._s.pub_period:
-            return  # a command just ran this cycle
+        if self._s.publish_on_command and now - self._last_cycle < _FILL_AFTER * self._s.pub_period:
+            return  # twists drive the cycles; the timer only fills in when one is late
         self._cycle(now)
 
     def _cycle(self, now: float) -> None:
@@ -190,15 +209,17 @@ class JogArmNode:
 
     def _publish_command(self, points: list[tuple[tuple[float, ...], tuple[float, ...], float]]) -> None:
         msg = self._cmd_msg
-        if isinstance(msg, Float64MultiArray):
-            msg.data = points[0][1]
-        else:
-            # Stamp 0: "start now" for joint_trajectory_controller, whatever the transport delay.
-            msg.points = [
-                JointTrajectoryPoint(positions=q, velocities=v, time_from_start=rospy.Duration.from_sec(t))
-                for q, v, t in points
-            ]
-        self._cmd_pub.publish(msg)
+        with self._pub_lock:  # the twist and timer threads share the message object
+            if isinstance(msg, Float64MultiArray):
+                msg.data = points[0][1]
+            else:
+                # Stamp 0: "start now" for joint_trajectory_controller, whatever the transport delay.
+                duration = rospy.Duration.from_sec
+                msg.points = [
+                    JointTrajectoryPoint(positions=q, velocities=v, time_from_start=duration(t))
+                    for q, v, t in points
+                ]
+            self._cmd_pub.publish(msg)
 
     @staticmethod
     def _log_status(status: StatusCode, message: str) -> None:
@@ -228,6 +249,10 @@ class JogArmNode:
         self._cycles.reset()
         return TriggerResponse(success=True, message=" ".join(f"{k}={v}" for k, v in summary.items()))
 
+    @property
+    def settings(self) -> JogSettings:
+        return self._s
+
     def shutdown(self) -> None:
         """Stops the timer and unregisters topics and services."""
         self._timer.shutdown()
@@ -251,19 +276,30 @@ def load(params: dict[str, Any], urdf_xml: str | None, prefix: str) -> tuple[Jog
     return settings, warnings
 
 
+def start(param_ns: str = "~", private_ns: str = "~", skip_callerid: str | None = None) -> JogArmNode | None:
+    """A node from the parameters in `param_ns` (after rospy.init_node); None, with a fatal log naming the
+    key, if start-up is refused."""
+    prefix = rospy.get_name() + "/" if param_ns == "~" else param_ns.rstrip("/") + "/"
+    try:
+        urdf = rospy.get_param("robot_description", None)
+        settings, warnings = load(rospy.get_param(param_ns, {}), urdf, prefix)
+        for warning in warnings:
+            rospy.logwarn(warning)
+        node = JogArmNode(settings, urdf, private_ns, skip_callerid)
+    except (SettingsError, KinematicsError) as err:
+        rospy.logfatal(f"jog_arm_server refused to start: {err}")
+        return None
+    rospy.on_shutdown(node.shutdown)
+    return node
+
+
 def main(argv: list[str] | None = None) -> int:
     """Runs the node until shutdown. Returns 1, with a fatal log naming the key, if start-up is refused."""
     rospy.init_node("jog_arm_server", argv=argv)
-    prefix = rospy.get_name() + "/"
-    try:
-        urdf = rospy.get_param("robot_description", None)
-        settings, warnings = load(rospy.get_param("~", {}), urdf, prefix)
-        for warning in warnings:
-            rospy.logwarn(warning)
-        node = JogArmNode(settings, urdf)
-    except (SettingsError, KinematicsError) as err:
-        rospy.logfatal(f"jog_arm_server refused to start: {err}")
+    node = start()
+    if node is None:
         return 1
+    settings = node.settings
     # A thread waiting for the GIL waits up to the switch interval (5 ms by default) for a busy one (rospy's
     # receive threads at 1 kHz) to let go: keep it well below the publish period so cycles start on time.
     sys.setswitchinterval(min(sys.getswitchinterval(), settings.pub_period / 10.0))
@@ -271,7 +307,6 @@ def main(argv: list[str] | None = None) -> int:
     # full passes, which would otherwise stall a cycle for milliseconds now and then.
     gc.collect()
     gc.freeze()
-    rospy.on_shutdown(node.shutdown)
     rospy.spin()
     return 0
 

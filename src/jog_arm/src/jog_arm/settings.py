@@ -104,6 +104,7 @@ class JogSettings:
     integrate_from: str = "commanded"
     max_tracking_error: float = 0.2  # [rad] re-sync to the measured state beyond this; 0 = never
     publish_on_command: bool = False  # also run a cycle when a twist arrives (lowest latency)
+    publish_synchronously: bool = False  # write the command socket in the cycle's thread (no sender thread)
 
     @classmethod
     def from_params(cls, params: Mapping[str, Any], prefix: str = "jog_arm_server/") -> JogSettings:

@@ -218,16 +218,17 @@ class MujocoDriverNode:
 
     def _publish(self) -> None:
         self._set_stamp()
-        joint = self._joint_msg
-        joint.header.stamp = self._stamp
-        # Lists serialise fastest in genpy (numpy scalars go through a slower path).
-        joint.position, joint.velocity, joint.effort = self._q.tolist(), self._qd.tolist(), self._tau.tolist()
-        self._joint_pub.publish(joint)
+        # The wrench first: it starts the force-control chain, the joint states only feed it.
         w, msg = self._w, self._wrench_msg
         msg.header.stamp = self._stamp
         f, t = msg.wrench.force, msg.wrench.torque
         f.x, f.y, f.z, t.x, t.y, t.z = w.tolist()
         self._wrench_pub.publish(msg)
+        joint = self._joint_msg
+        joint.header.stamp = self._stamp
+        # Lists serialise fastest in genpy (numpy scalars go through a slower path).
+        joint.position, joint.velocity, joint.effort = self._q.tolist(), self._qd.tolist(), self._tau.tolist()
+        self._joint_pub.publish(joint)
         self._pose_countdown -= 1
         if self._pose_countdown > 0:
             return
