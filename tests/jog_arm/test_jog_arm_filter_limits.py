@@ -122,3 +122,21 @@ def test_cycle_monitor_counts_missed_cycles() -> None:
     assert summary["max_gap_ms"] == pytest.approx(6.0)
     monitor.reset()
     assert monitor.tick(1.0) == 0 and monitor.summary()["missed"] == 0
+
+
+def test_publish_on_command_timer_fills_only_gaps_and_runs_every_tick_once_twists_stop() -> None:
+    from jog_arm.timing import timer_cycle_due
+
+    period, last_twist = 0.002, -1.0
+    timer_cycles = []
+    for k in range(200):  # 1 ms steps: a twist every 2 ms until 0.1 s, the timer ticking between them
+        t = k * 0.001
+        if k % 2 == 0 and t < 0.1:
+            last_twist = t
+        elif k % 2 == 1 and timer_cycle_due(t, last_twist, period, publish_on_command=True):
+            timer_cycles.append(t)
+    # No extra timer cycle between twists; after the last twist (0.098 s) the first tick past 1.25 periods,
+    # then every tick.
+    assert timer_cycles[0] == pytest.approx(0.101)
+    assert np.diff(timer_cycles) == pytest.approx(np.full(len(timer_cycles) - 1, period))
+    assert timer_cycle_due(0.0, 0.0, period, publish_on_command=False)

@@ -27,7 +27,8 @@ TOPICS = ("/joint_states", "/wrench", "/tf", "/mujoco_driver/eef_pose")
 SERVICES = ("/configure_cartesian_impedance", "/configure_cartesian_impedance_blocking",
             "/contact_control_node/tare", "/contact_control_node/stop", "/jog_arm_server/pause",
             "/mujoco_driver/push", "/mujoco_driver/reset")
-NODES = ("/mujoco_driver", "/control_stack", "/jog_arm_server", "/contact_control_node", "/robot_state_publisher")
+NODES = ("/mujoco_driver", "/control_stack", "/jog_arm_server", "/contact_control_node",
+         "/robot_state_publisher")
 
 
 def _registered_nodes() -> set[str]:

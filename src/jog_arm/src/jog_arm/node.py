@@ -28,15 +28,12 @@ from jog_arm.jog_calcs import JogCalcs
 from jog_arm.kinematics import KinematicsError
 from jog_arm.settings import JogSettings, SettingsError
 from jog_arm.status import StatusCode
-from jog_arm.timing import CycleMonitor
+from jog_arm.timing import CycleMonitor, timer_cycle_due
 
 __all__ = ["JogArmNode", "main", "start"]
 
 _TF_ERRORS = (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException)
 _WARN_PERIOD = 2.0  # [s] throttle of repeated warnings
-# publish_on_command: the timer runs a cycle only when none ran for this many periods. Above 1, so twists
-# arriving once per period never get an extra timer cycle between them (a duplicate command, older data).
-_FILL_AFTER = 1.25
 
 
 class JogArmNode:
@@ -65,7 +62,7 @@ class JogArmNode:
         self._tf_listener = tf2_ros.TransformListener(self._tf_buffer)
         self._frames_ready: set[str] = set()  # command frames known to be usable (model, or tf looked up)
         self._last_status = StatusCode.NO_JOINT_STATE
-        self._last_cycle = -math.inf
+        self._last_twist_cycle = -math.inf
         self._cycles = CycleMonitor(settings.pub_period)
         names = list(self._jog.joint_names)
         self._joint_set = frozenset(names)
@@ -137,6 +134,7 @@ class JogArmNode:
         if not result.accepted:
             rospy.logwarn_throttle(_WARN_PERIOD, f"jog_arm_server: command refused: {result.reason}")
         elif self._s.publish_on_command:
+            self._last_twist_cycle = now
             self._cycle(now)
 
     def _ensure_frame(self, frame: str) -> None:
@@ -168,13 +166,11 @@ class JogArmNode:
 
     def _on_timer(self, _event: rospy.timer.TimerEvent) -> None:
         now = rospy.get_time()
-        if self._s.publish_on_command and now - self._last_cycle < _FILL_AFTER * self._s.pub_period:
-            return  # twists drive the cycles; the timer only fills in when one is late
-        self._cycle(now)
+        if timer_cycle_due(now, self._last_twist_cycle, self._s.pub_period, self._s.publish_on_command):
+            self._cycle(now)
 
     def _cycle(self, now: float) -> None:
         """One control cycle: compute, publish the joint command and the status."""
-        self._last_cycle = now
         if self._cycles.tick(now):
             rospy.logwarn_throttle(
                 10.0,

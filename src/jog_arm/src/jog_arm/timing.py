@@ -5,7 +5,18 @@ from __future__ import annotations
 import collections
 import statistics
 
-__all__ = ["CycleMonitor"]
+__all__ = ["FILL_AFTER", "CycleMonitor", "timer_cycle_due"]
+
+
+# publish_on_command: the timer skips its tick while a twist ran a cycle less than this many periods ago.
+# Above 1, so twists arriving once per period never get an extra timer cycle between them (a duplicate
+# command, older data); once twists stop, the timer runs every tick again.
+FILL_AFTER = 1.25
+
+
+def timer_cycle_due(now: float, last_twist_cycle: float, period: float, publish_on_command: bool) -> bool:
+    """Whether a timer tick at `now` runs a cycle, given when a twist last ran one [s]."""
+    return not publish_on_command or now - last_twist_cycle >= FILL_AFTER * period
 
 
 class CycleMonitor:
