@@ -128,15 +128,18 @@ def test_publish_on_command_timer_fills_only_gaps_and_runs_every_tick_once_twist
     from jog_arm.timing import timer_cycle_due
 
     period, last_twist = 0.002, -1.0
+    # A twist every 2 ms until 0.1 s, one of them 0.95 periods late; the timer ticks at odd milliseconds.
+    twists = [k * 0.002 for k in range(50)]
+    twists[25] += 0.0019
+    ticks = [0.001 + k * 0.002 for k in range(100)]
     timer_cycles = []
-    for k in range(200):  # 1 ms steps: a twist every 2 ms until 0.1 s, the timer ticking between them
-        t = k * 0.001
-        if k % 2 == 0 and t < 0.1:
+    for t, is_tick in sorted([(t, False) for t in twists] + [(t, True) for t in ticks]):
+        if not is_tick:
             last_twist = t
-        elif k % 2 == 1 and timer_cycle_due(t, last_twist, period, publish_on_command=True):
+        elif timer_cycle_due(t, last_twist, period, publish_on_command=True):
             timer_cycles.append(t)
-    # No extra timer cycle between twists; after the last twist (0.098 s) the first tick past 1.25 periods,
-    # then every tick.
-    assert timer_cycles[0] == pytest.approx(0.101)
+    # No timer cycle between twists, not even for the late one (a tick found it 1.5 periods overdue); after
+    # the last twist (0.098 s) the first tick 2 periods on, then every tick.
+    assert timer_cycles[0] == pytest.approx(0.103)
     assert np.diff(timer_cycles) == pytest.approx(np.full(len(timer_cycles) - 1, period))
     assert timer_cycle_due(0.0, 0.0, period, publish_on_command=False)

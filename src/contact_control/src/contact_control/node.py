@@ -1,6 +1,7 @@
 """contact_control_node: the rospy adapter around `ContactControl` (see the package README).
 
-Per wrench: look up the transforms (static ones are cached, each frame at most once per cycle), run one
+Per wrench: look up the transforms (static ones are cached, each frame at most once per cycle; from the robot
+model instead of tf when jog_arm shares the process, see control_stack), run one
 `ContactControl.update` and publish the twist at once (lowest latency). A timer at ~control_rate detects stale
 wrenches and keeps publishing zero while a move waits for data. Twists are published while a move is active,
 then `idle_zero_count` zeros after it ends, then nothing, so other sources (keyboard jogging) can use the same
@@ -43,6 +44,9 @@ __all__ = ["ContactControlNode", "main", "read_settings", "tune_runtime"]
 
 _ZERO = (0.0,) * 6
 _TF_ERRORS = (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException)
+# (frame, relative_to) -> 4x4 rows, None if unknown; raises LookupError while it cannot answer yet.
+FrameSource = Callable[[str, str], "list[list[float]] | None"]
+TwistSink = Callable[[Sequence[float], str, float], None]
 
 
 class ContactControlNode:
@@ -52,29 +56,47 @@ class ContactControlNode:
         settings: Validated parameters.
         private_ns: Prefix of the private topics and services: "~" in a node of its own,
             "/contact_control_node/" when sharing a process (control_stack).
-        twist_sink: Called with each twist before it is published (same process: no hop).
+        twist_sink: Called as `(velocity, frame, t)` with each twist before it is published (same process:
+            no hop, no message): six floats in `velocity_command_frame`, `t` the time of the wrench [s].
+        frame_source: `(frame, relative_to) -> 4x4 rows`, None for a frame it does not know, LookupError
+            while it cannot answer yet: poses from the robot model (jog_arm in the same process), used before
+            tf. tf is then only listened to if some frame is not in the model.
+        own_subscribers: Subscriptions to the twist topic inside this process (fed through `twist_sink`): the
+            twist is only serialised and sent when somebody else listens too.
     """
 
     def __init__(
         self,
         settings: ContactControlSettings,
         private_ns: str = "~",
-        twist_sink: Callable[[TwistStamped], None] | None = None,
+        twist_sink: TwistSink | None = None,
+        frame_source: FrameSource | None = None,
+        own_subscribers: int = 0,
     ) -> None:
         s = self._s = settings
         self._ctrl = ContactControl(settings)
         self._limits = RequestLimits.from_settings(settings)
         self._lock = threading.Lock()
         self._move_ended = threading.Condition(self._lock)
-        self._buffer = tf2_ros.Buffer()
-        self._listener = tf2_ros.TransformListener(self._buffer)
         self._static: dict[str, list[list[float]]] = {s.fixed_frame: IDENTITY}
+        self._frame_source = frame_source
+        self._in_model: dict[str, bool] = {}
+        self._buffer: tf2_ros.Buffer | None = None
+        self._listener: tf2_ros.TransformListener | None = None
+        configured = {s.control_frame, s.ft_sensor_frame, s.eef_frame, s.velocity_command_frame}
+        from_tf = sorted(f for f in configured - {s.fixed_frame} if not self._model_has(f))
+        if from_tf or frame_source is None:
+            self._listen_to_tf()
+        if frame_source is not None:
+            rospy.loginfo("contact_control: frames %s from tf, the others from the robot model",
+                          from_tf or "none")
         self._time0 = rospy.Time(0)
         self._gravity = s.tool_mass > 0.0
         self._idle_zeros = 0
         self._was_active = False
         self._request_note = ""
         self._twist_sink = twist_sink
+        self._own_subscribers = own_subscribers
         self._twist = TwistStamped()
         self._twist.header.frame_id = s.velocity_command_frame
         # Synchronous: the twist leaves in the wrench callback, ~90 us sooner than through rospy's sender
@@ -104,11 +126,32 @@ class ContactControlNode:
         rospy.on_shutdown(self._on_shutdown)
 
     # --- tf ---
+    def _listen_to_tf(self) -> None:
+        self._buffer = tf2_ros.Buffer()
+        self._listener = tf2_ros.TransformListener(self._buffer)
+
+    def _model_has(self, frame: str) -> bool:
+        """Whether the frame source knows `frame` (relative to the fixed frame); asked once per frame."""
+        known = self._in_model.get(frame)
+        if known is None:
+            source = self._frame_source
+            try:
+                known = source is not None and source(frame, self._s.fixed_frame) is not None
+            except LookupError:  # known, just no joint state yet
+                known = True
+            self._in_model[frame] = known
+        return known
+
     def _lookup(self, frame: str) -> list[list[float]]:
-        """The pose of `frame` in the fixed frame (4x4 rows); cached when the chain is static."""
+        """The pose of `frame` in the fixed frame (4x4 rows): from the robot model if it has the frame, else
+        from tf (cached when the chain is static)."""
         cached = self._static.get(frame)
         if cached is not None:
             return cached
+        if self._model_has(frame):
+            return self._frame_source(frame, self._s.fixed_frame)  # type: ignore[misc]
+        if self._buffer is None:  # a wrench in a frame no configured name mentioned
+            self._listen_to_tf()
         # The core call: Buffer.lookup_transform adds a can_transform round trip (~4 us) that only waits.
         msg = self._buffer.lookup_transform_core(self._s.fixed_frame, frame, self._time0)
         t, q = msg.transform.translation, msg.transform.rotation
@@ -157,42 +200,49 @@ class ContactControlNode:
         with self._lock:
             try:
                 T_cs, R_ws, eef, R_fc, R_cc = self._frames(sensor_frame, self._ctrl.needs_travel)
-            except _TF_ERRORS as err:
-                self._publish(self._ctrl.hold(t, SAFETY_NO_TF, f"no transform: {err}"))
+            except (*_TF_ERRORS, LookupError) as err:
+                self._publish(self._ctrl.hold(t, SAFETY_NO_TF, f"no transform: {err}"), t)
             else:
-                self._publish(self._ctrl.update(wrench, t, T_cs, R_ws, eef, R_fc, stamp), R_cc)
+                self._publish(self._ctrl.update(wrench, t, T_cs, R_ws, eef, R_fc, stamp), t, R_cc)
+                if self._frame_source is not None:  # the model caches poses per joint state: fill it now,
+                    with contextlib.suppress(*_TF_ERRORS, LookupError):  # off the wrench-to-twist path
+                        self._frames(sensor_frame, self._ctrl.needs_travel)
 
     def _on_timer(self, _event: Any) -> None:
         with self._lock:
-            result = self._ctrl.check_stale(rospy.get_time())
+            t = rospy.get_time()
+            result = self._ctrl.check_stale(t)
             if result is not None:
-                self._publish(result)
+                self._publish(result, t)
 
-    def _publish(self, result: CycleResult, R_command_control: Any = None) -> None:
+    def _publish(self, result: CycleResult, t: float, R_command_control: Any = None) -> None:
         """Twist out according to the publish policy; wakes blocking callers when a move ends."""
         if result.move_active:
             self._idle_zeros = int(self._s.idle_zero_count)
             v = result.velocity
-            self._send(v if R_command_control is None or not any(v) else rotate_twist(R_command_control, v))
+            if R_command_control is not None and any(v):
+                v = rotate_twist(R_command_control, v)
+            self._send(v, t)
         elif self._was_active:
             self._move_ended.notify_all()
-            self._send(_ZERO)  # at least one zero right away, whatever idle_zero_count says
+            self._send(_ZERO, t)  # at least one zero right away, whatever idle_zero_count says
         elif self._idle_zeros > 0:
             self._idle_zeros -= 1
-            self._send(_ZERO)
+            self._send(_ZERO, t)
         elif self._s.publish_when_idle:
-            self._send(_ZERO)
+            self._send(_ZERO, t)
         self._was_active = result.move_active
 
-    def _send(self, velocity: Sequence[float]) -> None:
-        """Publishes a twist already expressed in velocity_command_frame."""
-        tw = self._twist
-        tw.header.stamp = rospy.Time.now()
-        lin, ang = tw.twist.linear, tw.twist.angular
-        lin.x, lin.y, lin.z, ang.x, ang.y, ang.z = velocity
+    def _send(self, velocity: Sequence[float], t: float) -> None:
+        """A twist already expressed in velocity_command_frame, for the wrench (or timer tick) at `t`."""
         if self._twist_sink is not None:
-            self._twist_sink(tw)
-        self._twist_pub.publish(tw)
+            self._twist_sink(velocity, self._s.velocity_command_frame, t)
+        if self._twist_pub.get_num_connections() > self._own_subscribers:
+            tw = self._twist
+            tw.header.stamp = rospy.Time.from_sec(t)  # the time of the wrench the twist answers
+            lin, ang = tw.twist.linear, tw.twist.angular
+            lin.x, lin.y, lin.z, ang.x, ang.y, ang.z = velocity
+            self._twist_pub.publish(tw)
 
     # --- services ---
     def _configure(self, req: Any) -> int | None:
@@ -248,7 +298,7 @@ class ContactControlNode:
                 self._move_ended.notify_all()
                 self._was_active = False
                 self._idle_zeros = int(self._s.idle_zero_count)
-                self._send(_ZERO)
+                self._send(_ZERO, rospy.get_time())
         return TriggerResponse(success=True, message="move stopped" if stopped else "no move was running")
 
     def _on_reset(self, _req: Any) -> TriggerResponse:
@@ -282,7 +332,7 @@ class ContactControlNode:
             if self._ctrl.stop("shutdown"):
                 self._move_ended.notify_all()
                 with contextlib.suppress(rospy.ROSException):  # the publisher may already be closing
-                    self._send(_ZERO)
+                    self._send(_ZERO, rospy.get_time())
 
 
 def read_settings(param_ns: str = "~") -> ContactControlSettings | None:

@@ -1,11 +1,12 @@
 """control_stack_node: contact_control_node and jog_arm_server sharing one process.
 
 rospy has no nodelets, so each node hop costs a serialisation, a socket and a deserialisation (about
-150 us here). In one process contact_control calls jog_arm with each twist directly. Everything else keeps
-the separate nodes' names: parameters under /contact_control_node and /jog_arm_server (relative to the
-process's namespace), their private topics and services there, the same public topics. The twist is still
-published for observers (rosbag, rqt_plot); when jog_arm's input is that same topic, jog_arm drops the copy
-coming back from this process, so every twist is handled once.
+150 us here). In one process contact_control calls jog_arm with each twist directly and takes its frames
+from jog_arm's robot model at the last joint state (no /tf to deserialise). Everything else keeps the
+separate nodes' names: parameters under /contact_control_node and /jog_arm_server (relative to the
+process's namespace), their private topics and services there, the same public topics. The twist is
+still published when an observer listens (rosbag, rqt_plot); jog_arm drops the copy coming back from
+this process, so every twist is handled once.
 """
 
 from __future__ import annotations
@@ -31,7 +32,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     settings = read_settings(cc_ns)
     if jog is None or settings is None:
         return 1
-    ContactControlNode(settings, private_ns=cc_ns, twist_sink=jog.accept_twist)
+    twist_topic = rospy.resolve_name(settings.velocity_out_topic)
+    same_topic = twist_topic == rospy.resolve_name(jog.settings.cmd_in_topic)
+    ContactControlNode(
+        settings,
+        private_ns=cc_ns,
+        twist_sink=jog.accept_velocity,
+        frame_source=jog.model_frame_pose,
+        own_subscribers=int(same_topic),
+    )
     tune_runtime(min(1.0 / settings.control_rate, jog.settings.pub_period))
     rospy.loginfo(
         "control_stack: contact_control (%s) -> jog_arm (%s) in one process; wrench in %s, joint commands "

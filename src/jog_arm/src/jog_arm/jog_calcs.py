@@ -89,18 +89,35 @@ class JogOutput:
         self.speed_scale = 0.0
 
 
+_ACCEPTED = CommandResult(True)
+
+
 class _Frame:
     """A command frame resolved against the model: a model frame, possibly with a fixed extra rotation."""
 
-    __slots__ = ("extra", "frame_id", "on_chain", "static")
+    __slots__ = ("extra", "frame_id", "on_chain", "static", "static_rows")
 
     def __init__(
         self, frame_id: int, static: np.ndarray | None, on_chain: bool, extra: np.ndarray | None
     ) -> None:
         self.frame_id = frame_id
         self.static = static  # root <- frame rotation if it never moves, else None
+        self.static_rows = None if static is None else tuple(map(tuple, static.tolist()))
         self.on_chain = on_chain
         self.extra = extra  # model frame <- command frame rotation, or None
+
+
+class _Geometry:
+    """What a cycle needs that does not depend on the twist, at configuration `q` (see JogCalcs._geometry)."""
+
+    __slots__ = ("J", "condition", "q", "q_arr", "valid")
+
+    def __init__(self) -> None:
+        self.valid = False
+        self.q: list[float] = []
+        self.q_arr: np.ndarray = np.zeros(0)
+        self.J: np.ndarray = np.zeros((6, 0))
+        self.condition = math.inf
 
 
 class JogCalcs:
@@ -168,9 +185,9 @@ class JogCalcs:
         self._gain_posture = self._ns_gain * posture
         self._redundant = n > 6 and settings.nullspace_gain > 0.0
         if settings.command_in_type == "unitless":
-            self._unit_scale = np.array([settings.scale_linear] * 3 + [settings.scale_rotational] * 3)
+            self._unit_scales = (float(settings.scale_linear), float(settings.scale_rotational))
         else:
-            self._unit_scale = np.ones(6)
+            self._unit_scales = (1.0, 1.0)
         self._damping2 = settings.pinv_damping**2
         self._damping_threshold = settings.pinv_damping_threshold
         self._inv_length = 1.0 / settings.singularity_length_scale
@@ -202,6 +219,10 @@ class JogCalcs:
         self._names_cache: tuple[tuple[str, ...], list[int]] = ((), [])
         self._zeros = (0.0,) * n
         self._out = JogOutput(n)
+        self._pose_ids: dict[tuple[str, str], tuple[int, int]] = {}
+        self._poses: dict[tuple[str, str], list[list[float]]] = {}  # at the joint state _poses_q
+        self._poses_q: object = None
+        self._geom = _Geometry()
 
     # --- inputs ---------------------------------------------------------------------------------------
 
@@ -292,7 +313,7 @@ class JogCalcs:
         reason = ""
         if len(twist) != 6:
             reason = f"a twist has 6 components, got {len(twist)}"
-        elif not all(math.isfinite(v) for v in twist):
+        elif not all(map(math.isfinite, twist)):
             reason = f"non-finite value in twist {list(twist)}"
         elif self.settings.command_in_type == "unitless" and any(abs(v) > 1.0 for v in twist):
             reason = f"unitless twist components must be within [-1, 1], got {list(twist)}"
@@ -304,16 +325,27 @@ class JogCalcs:
             self._rejected = reason
             return CommandResult(False, reason)
         self._rejected = ""
-        np.multiply(twist, self._unit_scale, out=self._twist)
+        # Plain floats: at this size numpy's per-call overhead dominates, more so with cold caches.
+        lin, rot = self._unit_scales
+        vx, vy, vz, wx, wy, wz = twist
+        vx, vy, vz, wx, wy, wz = vx * lin, vy * lin, vz * lin, wx * rot, wy * rot, wz * rot
+        self._twist[:] = (vx, vy, vz, wx, wy, wz)
         self._cmd_zero = not any(twist)
         self._cmd_frame = resolved
-        if resolved.static is not None:  # rotate once, not every cycle
-            x = self._twist_weighted
-            np.dot(resolved.static, self._twist[:3], out=x[:3])
-            np.dot(resolved.static, self._twist[3:], out=x[3:])
-            x *= self._row_weights
+        rows = resolved.static_rows
+        if rows is not None:  # rotate once, not every cycle
+            (a, b, c), (d, e, f), (g, h, i) = rows
+            k = self._inv_length
+            self._twist_weighted[:] = (
+                (a * vx + b * vy + c * vz) * k,
+                (d * vx + e * vy + f * vz) * k,
+                (g * vx + h * vy + i * vz) * k,
+                a * wx + b * wy + c * wz,
+                d * wx + e * wy + f * wz,
+                g * wx + h * wy + i * wz,
+            )
         self._cmd_time = now
-        return CommandResult(True)
+        return _ACCEPTED
 
     def pause(self) -> None:
         """Stops (smoothly) and ignores commands until :meth:`resume`."""
@@ -351,16 +383,7 @@ class JogCalcs:
             return out
 
         # 1. Reference configuration (plain float lists: cheaper than numpy for 6-7 values).
-        resynced = False
-        q_meas = self._q_meas
-        if self._running and self._from_commanded:
-            q_ref = self._q_cmd
-            limit = settings.max_tracking_error
-            if limit > 0.0 and max(map(abs, map(operator.sub, q_meas, q_ref))) > limit:
-                q_ref = q_meas
-                resynced = True
-        else:
-            q_ref = q_meas
+        q_ref, resynced = self._reference()
 
         # What to follow.
         status = StatusCode.NO_WARNING
@@ -382,21 +405,13 @@ class JogCalcs:
         if not follow and not any(dq_out):
             return self._hold(q_ref, status, message)
 
-        q_arr = self._q_ref
-        q_arr[:] = q_ref
+        # 2. Jacobian, condition number, factorised damped J·Jᵀ (computed ahead by prefetch() if it could).
+        geometry = self._geometry(q_ref)
+        q_arr, J, condition = geometry.q_arr, geometry.J, geometry.condition
         if not self._running:
             self._running = True
             if not self._posture_fixed:
                 np.multiply(q_arr, self._ns_gain, out=self._gain_posture)
-
-        # 2. Jacobian; the eigenvalues of J·Jᵀ are the squared singular values (eigenpy: ~2 µs).
-        J = self.model.jacobian(q_arr)
-        J[:3] *= self._inv_length
-        A = np.dot(J, J.T, out=self._jjt)
-        self._eig.compute(A, _EIGENVALUES_ONLY)
-        sigma2 = self._eig.eigenvalues()  # ascending; a view, valid until the next compute
-        s2_min = float(sigma2[0])
-        condition = math.sqrt(float(sigma2[-1]) / s2_min) if s2_min > 0.0 else math.inf
         out.condition_number = condition
 
         s_sing = 1.0
@@ -412,15 +427,7 @@ class JogCalcs:
                 np.dot(rot, self._twist[:3], out=x[:3])
                 np.dot(rot, self._twist[3:], out=x[3:])
                 x *= self._row_weights
-            s_min = math.sqrt(max(s2_min, 0.0))
-            if s_min < self._damping_threshold:
-                ratio = s_min / self._damping_threshold
-                A += self._eye6 * (self._damping2 * (1.0 - ratio * ratio) + _DAMPING_FLOOR)
             llt = self._llt
-            llt.compute(A)
-            if llt.info() != eigenpy.ComputationInfo.Success:  # numerically singular: damp harder
-                A += self._eye6 * (_DAMPING_FLOOR + 1e-6 * float(sigma2[-1]))
-                llt.compute(A)
             if self._redundant:
                 pull = self._gain_posture - self._ns_gain * q_arr
                 dq_arr = J.T @ llt.solve(x - J @ pull)
@@ -487,6 +494,58 @@ class JogCalcs:
         out.message = message
         return out
 
+    def prefetch(self) -> None:
+        """Computes the next cycle's twist-independent part now (Jacobian, condition number, factorisation),
+        so the next :meth:`step`, if its reference configuration is still this one, only solves for the
+        twist: call it after publishing, off the path from twist to command."""
+        if self._have_state and self._running:
+            self._geometry(self._reference()[0])
+
+    def _reference(self) -> tuple[list[float], bool]:
+        """(reference configuration of the next step, whether it is a re-sync to the measured state)."""
+        q_meas = self._q_meas
+        if self._running and self._from_commanded:
+            q_ref = self._q_cmd
+            limit = self.settings.max_tracking_error
+            if limit > 0.0 and max(map(abs, map(operator.sub, q_meas, q_ref))) > limit:
+                return q_meas, True
+            return q_ref, False
+        return q_meas, False
+
+    def _geometry(self, q_ref: list[float]) -> _Geometry:
+        """The twist-independent part of a cycle at `q_ref`, reused while `q_ref` does not change.
+
+        Also leaves the placements of the tip's chain at `q_ref` in the model's data (see ArmModel.jacobian);
+        whatever else moves the data invalidates this.
+        """
+        g = self._geom
+        if g.valid and g.q == q_ref:
+            return g
+        q_arr = self._q_ref
+        q_arr[:] = q_ref
+        # The eigenvalues of J·Jᵀ are the squared singular values (eigenpy: ~2 µs).
+        J = self.model.jacobian(q_arr)
+        J[:3] *= self._inv_length
+        A = np.dot(J, J.T, out=self._jjt)
+        self._eig.compute(A, _EIGENVALUES_ONLY)
+        sigma2 = self._eig.eigenvalues()  # ascending; a view, valid until the next compute
+        s2_min, s2_max = float(sigma2[0]), float(sigma2[-1])
+        # Damped pseudo-inverse J⁺ = Jᵀ(JJᵀ + λ²I)⁻¹: λ grows as the smallest singular value falls.
+        s_min = math.sqrt(max(s2_min, 0.0))
+        if s_min < self._damping_threshold:
+            ratio = s_min / self._damping_threshold
+            A += self._eye6 * (self._damping2 * (1.0 - ratio * ratio) + _DAMPING_FLOOR)
+        llt = self._llt
+        llt.compute(A)
+        if llt.info() != eigenpy.ComputationInfo.Success:  # numerically singular: damp harder
+            A += self._eye6 * (_DAMPING_FLOOR + 1e-6 * s2_max)
+            llt.compute(A)
+        g.q = list(q_ref)
+        g.q_arr, g.J = q_arr, J
+        g.condition = math.sqrt(s2_max / s2_min) if s2_min > 0.0 else math.inf
+        g.valid = True
+        return g
+
     def _user_order(self, values: list[float]) -> tuple[float, ...]:
         """Model-order `values` as a user-order tuple."""
         if self._identity_order:
@@ -517,6 +576,7 @@ class JogCalcs:
         norm = max(map(abs, dq.tolist()))
         if norm == 0.0:
             return 0.0
+        self._geom.valid = False
         J = self._weighted_jacobian(q + dq * (_PREDICTION_STEP / norm))
         self._eig_only.compute(J @ J.T, _EIGENVALUES_ONLY)
         sigma2 = self._eig_only.eigenvalues()
@@ -571,7 +631,33 @@ class JogCalcs:
         q = self._q_ref.copy() if positions is None else np.empty(self.nv)
         if positions is not None:
             q[self._to_user] = np.asarray(positions, dtype=float)
+        self._geom.valid = False  # frame_pose moves the model's data
         return self.model.frame_pose(q, self.settings.ee_frame_name, self.settings.planning_frame)
+
+    def measured_frame_pose(self, frame: str, relative_to: str) -> list[list[float]] | None:
+        """Pose (4x4 rows) of model frame `frame` in model frame `relative_to` at the last measured joint
+        state; None if either is not a frame of the model. Computed once per joint state (callers must not
+        modify the rows).
+
+        Raises:
+            LookupError: No joint state received yet.
+        """
+        if not (self.model.has_frame(frame) and self.model.has_frame(relative_to)):
+            return None
+        if not self._have_state:
+            raise LookupError("no joint state received yet")
+        q = self._q_meas
+        if q is not self._poses_q:  # a new joint state: earlier answers are out of date
+            self._poses.clear()
+            self._poses_q = q
+        key = (frame, relative_to)
+        pose = self._poses.get(key)
+        if pose is None:
+            ids = self._pose_ids.get(key)
+            if ids is None:
+                ids = self._pose_ids[key] = (self.model.frame_id(frame), self.model.frame_id(relative_to))
+            pose = self._poses[key] = self.model.measured_pose(q, *ids).tolist()
+        return pose
 
     def _resolve_frame(self, name: str) -> _Frame | None:
         frame = self._frames.get(name)

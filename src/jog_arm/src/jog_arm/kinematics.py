@@ -68,6 +68,8 @@ class ArmModel:
         model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
         self.model = model
         self.data = model.createData()
+        self._pose_data = model.createData()  # for measured_pose, so it never disturbs a cycle's data
+        self._pose_q: object = None
         self.nv = model.nv
         # Kinematic order of the controlled joints: index i of every array in this class.
         self.joint_names: tuple[str, ...] = tuple(model.names[1:])
@@ -163,6 +165,21 @@ class ArmModel:
             base = pin.updateFramePlacement(self.model, self.data, self.frame_id(relative_to))
             pose = base.actInv(pose)
         return pose
+
+
+    def measured_pose(self, q: Sequence[float], frame_id: int, base_id: int) -> np.ndarray:
+        """4x4 pose of frame `frame_id` in frame `base_id` at `q` (model order).
+
+        Forward kinematics runs once per `q` object: several frames asked at the same state share it.
+        """
+        data = self._pose_data
+        if q is not self._pose_q:
+            pin.forwardKinematics(self.model, data, np.asarray(q, dtype=float))
+            self._pose_q = q
+        pose = pin.updateFramePlacement(self.model, data, frame_id)
+        if base_id != 0:  # frame 0 is the root ("universe")
+            pose = pin.updateFramePlacement(self.model, data, base_id).actInv(pose)
+        return pose.homogeneous
 
 
 def _chain_joints(model: pin.Model, tip_frame: str) -> list[str]:

@@ -12,6 +12,7 @@ import gc
 import math
 import sys
 import threading
+from collections.abc import Sequence
 from typing import Any
 
 import pinocchio as pin
@@ -44,7 +45,7 @@ class JogArmNode:
         urdf_xml: The robot description.
         private_ns: Prefix of the private topics and services: "~" in a node of its own,
             "/jog_arm_server/" when sharing a process (control_stack).
-        skip_callerid: Twists from this publisher (the process itself) arrive through `accept_twist`,
+        skip_callerid: Twists from this publisher (the process itself) arrive through `accept_velocity`,
             so their copies on the topic are dropped.
 
     Raises:
@@ -58,12 +59,15 @@ class JogArmNode:
         self._jog = JogCalcs(settings, urdf_xml)
         self._lock = threading.Lock()
         self._pub_lock = threading.Lock()
-        self._tf_buffer = tf2_ros.Buffer()
-        self._tf_listener = tf2_ros.TransformListener(self._tf_buffer)
+        # tf only for command frames the model lacks: created on the first such frame, so the usual case
+        # spends no thread on deserialising /tf.
+        self._tf_buffer: tf2_ros.Buffer | None = None
+        self._tf_listener: tf2_ros.TransformListener | None = None
         self._frames_ready: set[str] = set()  # command frames known to be usable (model, or tf looked up)
         self._last_status = StatusCode.NO_JOINT_STATE
         self._last_twist_cycle = -math.inf
         self._cycles = CycleMonitor(settings.pub_period)
+        self._next_missed_warning = -math.inf
         names = list(self._jog.joint_names)
         self._joint_set = frozenset(names)
         self._points = settings.simu_points if settings.simu else 1
@@ -123,12 +127,16 @@ class JogArmNode:
         self.accept_twist(msg)
 
     def accept_twist(self, msg: TwistStamped) -> None:
-        """A velocity command, from the topic or from a controller in the same process."""
-        now = rospy.get_time()
-        frame = msg.header.frame_id.lstrip("/")
-        self._ensure_frame(frame or self._s.default_cmd_frame)
+        """A velocity command from the topic."""
         lin, ang = msg.twist.linear, msg.twist.angular
         twist = (lin.x, lin.y, lin.z, ang.x, ang.y, ang.z)
+        self.accept_velocity(twist, msg.header.frame_id, rospy.get_time())
+
+    def accept_velocity(self, twist: Sequence[float], frame: str, now: float) -> None:
+        """A velocity command (vx, vy, vz, wx, wy, wz) in `frame` ("": the default) received at `now` [s]:
+        from the topic, or from a controller in the same process (no message to fill and read back)."""
+        frame = frame.lstrip("/")
+        self._ensure_frame(frame or self._s.default_cmd_frame)
         with self._lock:
             result = self._jog.set_command(twist, frame, now)
         if not result.accepted:
@@ -146,6 +154,9 @@ class JogArmNode:
         if known:
             self._frames_ready.add(frame)
             return
+        if self._tf_buffer is None:
+            self._tf_buffer = tf2_ros.Buffer()
+            self._tf_listener = tf2_ros.TransformListener(self._tf_buffer)
         try:
             tf = self._tf_buffer.lookup_transform(self._s.planning_frame, frame, rospy.Time(0))
         except _TF_ERRORS as err:  # not cached: tf may still be filling up; try again next command
@@ -171,11 +182,12 @@ class JogArmNode:
 
     def _cycle(self, now: float) -> None:
         """One control cycle: compute, publish the joint command and the status."""
-        if self._cycles.tick(now):
-            rospy.logwarn_throttle(
-                10.0,
+        # Throttled here: rospy's logwarn_throttle inspects the caller's source file (~100 us) on every call.
+        if self._cycles.tick(now) and now >= self._next_missed_warning:
+            self._next_missed_warning = now + 10.0
+            rospy.logwarn(
                 f"jog_arm_server: {self._cycles.missed} publish cycles missed so far "
-                f"(longest gap {self._cycles.max_gap * 1e3:.1f} ms, period {self._s.pub_period * 1e3:g} ms)",
+                f"(longest gap {self._cycles.max_gap * 1e3:.1f} ms, period {self._s.pub_period * 1e3:g} ms)"
             )
         with self._lock:
             out = self._jog.step(now)
@@ -202,6 +214,9 @@ class JogArmNode:
         if status != self._last_status:
             self._log_status(status, message)
             self._last_status = status
+        if publish:
+            with self._lock:  # the next cycle's Jacobian now, while it is off the twist-to-command path
+                self._jog.prefetch()
 
     def _publish_command(self, points: list[tuple[tuple[float, ...], tuple[float, ...], float]]) -> None:
         msg = self._cmd_msg
@@ -244,6 +259,16 @@ class JogArmNode:
         summary = self._cycles.summary()
         self._cycles.reset()
         return TriggerResponse(success=True, message=" ".join(f"{k}={v}" for k, v in summary.items()))
+
+    def model_frame_pose(self, frame: str, relative_to: str) -> list[list[float]] | None:
+        """Pose (4x4 rows) of a robot-model frame in another at the last joint state, for a controller in the
+        same process (fresher than tf and no /tf to deserialise); None if either is not a model frame.
+
+        Raises:
+            LookupError: No joint state received yet.
+        """
+        with self._lock:
+            return self._jog.measured_frame_pose(frame, relative_to)
 
     @property
     def settings(self) -> JogSettings:

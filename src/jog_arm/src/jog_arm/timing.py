@@ -9,9 +9,10 @@ __all__ = ["FILL_AFTER", "CycleMonitor", "timer_cycle_due"]
 
 
 # publish_on_command: the timer skips its tick while a twist ran a cycle less than this many periods ago.
-# Above 1, so twists arriving once per period never get an extra timer cycle between them (a duplicate
-# command, older data); once twists stop, the timer runs every tick again.
-FILL_AFTER = 1.25
+# 2: the timer stands in for a missing twist, never for a late one (a twist up to a period late gets no
+# duplicate, older command just before it, competing with it for the interpreter); once twists stop, the
+# timer runs every tick again.
+FILL_AFTER = 2.0
 
 
 def timer_cycle_due(now: float, last_twist_cycle: float, period: float, publish_on_command: bool) -> bool:
