@@ -124,22 +124,24 @@ def test_cycle_monitor_counts_missed_cycles() -> None:
     assert monitor.tick(1.0) == 0 and monitor.summary()["missed"] == 0
 
 
-def test_publish_on_command_timer_fills_only_gaps_and_runs_every_tick_once_twists_stop() -> None:
-    from jog_arm.timing import timer_cycle_due
+def test_publish_on_command_gap_filler_runs_only_when_twists_stop() -> None:
+    from jog_arm.timing import next_fill_time
 
-    period, last_twist = 0.002, -1.0
-    # A twist every 2 ms until 0.1 s, one of them 0.95 periods late; the timer ticks at odd milliseconds.
-    twists = [k * 0.002 for k in range(50)]
+    period = 0.002
+    # Twists every 2 ms until 0.1 s (one of them 0.95 periods late, two in a row missing), the filler
+    # sleeping until its next due time like the node's thread.
+    twists = [k * 0.002 for k in range(50) if k not in (40, 41)]
     twists[25] += 0.0019
-    ticks = [0.001 + k * 0.002 for k in range(100)]
-    timer_cycles = []
-    for t, is_tick in sorted([(t, False) for t in twists] + [(t, True) for t in ticks]):
-        if not is_tick:
-            last_twist = t
-        elif timer_cycle_due(t, last_twist, period, publish_on_command=True):
-            timer_cycles.append(t)
-    # No timer cycle between twists, not even for the late one (a tick found it 1.5 periods overdue); after
-    # the last twist (0.098 s) the first tick 2 periods on, then every tick.
-    assert timer_cycles[0] == pytest.approx(0.103)
-    assert np.diff(timer_cycles) == pytest.approx(np.full(len(timer_cycles) - 1, period))
-    assert timer_cycle_due(0.0, 0.0, period, publish_on_command=False)
+    last_twist, last_fill, fills = -1.0, -1.0, []
+    for k in range(1, 200_000):  # 1 us steps
+        t = k * 1e-6
+        if twists and t >= twists[0]:
+            last_twist = twists.pop(0)
+        if t >= next_fill_time(last_twist, last_fill, period):
+            last_fill = t
+            fills.append(t)
+    # One fill 2.5 periods after the twist before the missing ones (0.078 s); none for the late twist; after
+    # the last twist (0.098 s) one at 2.5 periods, then one per period.
+    assert fills[0] == pytest.approx(0.083, abs=2e-6)
+    assert fills[1] == pytest.approx(0.103, abs=2e-6)
+    assert np.diff(fills[1:]) == pytest.approx(np.full(len(fills) - 2, period), abs=2e-6)

@@ -6,7 +6,8 @@ Decisions (the README repeats them):
   still (zero velocity) and the result says which axis and condition ended it.
 - NaN/inf wrench: zero output in that same cycle (SAFETY_NAN); the move resumes with the next valid wrench.
 - Stale wrench (none for `wrench_timeout`, or a header stamp older than that): zero output (SAFETY_STALE) from
-  `check_stale`, which the node calls from its timer; after `no_data_end_timeout` the move ends (NO_FT_DATA).
+  `check_stale`, which the node calls once the data is due to turn stale (`fresh_until`); after
+  `no_data_end_timeout` the move ends (NO_FT_DATA).
 - Wrench over `global_max_force`/`global_max_torque`: zero output, the move ends (FT_VIOLATION on its active
   axes) and the safety stays latched, refusing new laws, until `reset_safety()`.
 - After any pause the velocity restarts from zero under the acceleration limit.
@@ -16,6 +17,7 @@ Not thread-safe: the node serialises calls with one lock.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import Any, NamedTuple
 
@@ -375,6 +377,11 @@ class ContactControl:
             if t - self._from_rest >= self._arm_time:
                 self._armed = [True] * 6
         return self._result(t, SAFETY_OK, "")
+
+    @property
+    def fresh_until(self) -> float:
+        """Time [s] until which the newest wrench counts as fresh (-inf before the first one)."""
+        return -math.inf if self._last_rx is None else self._last_rx + self._timeout
 
     def check_stale(self, t: float) -> CycleResult | None:
         """Timer check: None while wrenches are fresh, else a zero-output result (SAFETY_STALE).

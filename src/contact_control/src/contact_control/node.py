@@ -1,11 +1,11 @@
 """contact_control_node: the rospy adapter around `ContactControl` (see the package README).
 
-Per wrench: look up the transforms (static ones are cached, each frame at most once per cycle; from the robot
-model instead of tf when jog_arm shares the process, see control_stack), run one
-`ContactControl.update` and publish the twist at once (lowest latency). A timer at ~control_rate detects stale
-wrenches and keeps publishing zero while a move waits for data. Twists are published while a move is active,
-then `idle_zero_count` zeros after it ends, then nothing, so other sources (keyboard jogging) can use the same
-topic in between.
+Per wrench: look up the transforms (static ones are cached, each frame at most once per cycle; from the
+robot model instead of tf when jog_arm shares the process, see control_stack), run one
+`ContactControl.update` and publish the twist at once (lowest latency). A thread wakes when the newest
+wrench turns stale and then keeps publishing zero at ~control_rate while a move waits for data. Twists are
+published while a move is active, then `idle_zero_count` zeros after it ends, then nothing, so other
+sources (keyboard jogging) can use the same topic in between.
 """
 
 from __future__ import annotations
@@ -121,7 +121,7 @@ class ContactControlNode:
         self._sub = rospy.Subscriber(
             s.ft_in_topic, WrenchStamped, self._on_wrench, queue_size=1, tcp_nodelay=True
         )
-        self._timer = rospy.Timer(rospy.Duration(1.0 / s.control_rate), self._on_timer)
+        threading.Thread(target=self._watch_staleness, name="contact_control_staleness", daemon=True).start()
         self._status_timer = rospy.Timer(rospy.Duration(1.0 / s.status_rate), self._on_status)
         rospy.on_shutdown(self._on_shutdown)
 
@@ -208,12 +208,22 @@ class ContactControlNode:
                     with contextlib.suppress(*_TF_ERRORS, LookupError):  # off the wrench-to-twist path
                         self._frames(sensor_frame, self._ctrl.needs_travel)
 
-    def _on_timer(self, _event: Any) -> None:
-        with self._lock:
-            t = rospy.get_time()
-            result = self._ctrl.check_stale(t)
-            if result is not None:
-                self._publish(result, t)
+    def _watch_staleness(self) -> None:
+        """Sleeps until the newest wrench turns stale; while data is missing, runs the stale check every
+        1/control_rate (zeros for jog_arm, the move's end after no_data_end_timeout). A fixed-rate timer would
+        wake the process control_rate times a second for nothing."""
+        period = 1.0 / self._s.control_rate
+        while not rospy.is_shutdown():
+            with self._lock:
+                t = rospy.get_time()
+                result = self._ctrl.check_stale(t)
+                if result is not None:
+                    self._publish(result, t)
+                wait = period if result is not None else max(self._ctrl.fresh_until - t, period)
+            try:
+                rospy.sleep(wait)
+            except rospy.ROSInterruptException:
+                return
 
     def _publish(self, result: CycleResult, t: float, R_command_control: Any = None) -> None:
         """Twist out according to the publish policy; wakes blocking callers when a move ends."""

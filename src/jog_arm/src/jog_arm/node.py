@@ -29,7 +29,7 @@ from jog_arm.jog_calcs import JogCalcs
 from jog_arm.kinematics import KinematicsError
 from jog_arm.settings import JogSettings, SettingsError
 from jog_arm.status import StatusCode
-from jog_arm.timing import CycleMonitor, timer_cycle_due
+from jog_arm.timing import CycleMonitor, next_fill_time
 
 __all__ = ["JogArmNode", "main", "start"]
 
@@ -95,7 +95,12 @@ class JogArmNode:
             rospy.Subscriber(settings.joint_topic, JointState, self._on_joints, **fast),
             rospy.Subscriber(settings.cmd_in_topic, TwistStamped, self._on_twist, **fast),
         ]
-        self._timer = rospy.Timer(rospy.Duration(settings.pub_period), self._on_timer)
+        self._closed = False
+        if settings.publish_on_command:  # twists run the cycles; a timer would wake 1/pub_period times a s
+            self._timer: rospy.Timer | None = None
+            threading.Thread(target=self._fill_gaps, name="jog_arm_gap_filler", daemon=True).start()
+        else:
+            self._timer = rospy.Timer(rospy.Duration(settings.pub_period), self._on_timer)
         rospy.loginfo(
             "jog_arm_server: %d joints %s, tip %s, commands on %s (%s) -> %s on %s every %.4f s",
             len(names),
@@ -176,9 +181,23 @@ class JogArmNode:
         )
 
     def _on_timer(self, _event: rospy.timer.TimerEvent) -> None:
-        now = rospy.get_time()
-        if timer_cycle_due(now, self._last_twist_cycle, self._s.pub_period, self._s.publish_on_command):
-            self._cycle(now)
+        self._cycle(rospy.get_time())
+
+    def _fill_gaps(self) -> None:
+        """publish_on_command: sleeps while twists run the cycles; runs one when a twist is missing and one
+        per period once twists stop (see timing.FILL_AFTER)."""
+        period, last_fill = self._s.pub_period, -math.inf
+        while not (self._closed or rospy.is_shutdown()):
+            now = rospy.get_time()
+            due = next_fill_time(self._last_twist_cycle, last_fill, period)
+            if now >= due:
+                last_fill = now
+                self._cycle(now)
+                due = next_fill_time(self._last_twist_cycle, last_fill, period)
+            try:
+                rospy.sleep(max(due - rospy.get_time(), 1e-4))
+            except rospy.ROSInterruptException:
+                return
 
     def _cycle(self, now: float) -> None:
         """One control cycle: compute, publish the joint command and the status."""
@@ -276,7 +295,9 @@ class JogArmNode:
 
     def shutdown(self) -> None:
         """Stops the timer and unregisters topics and services."""
-        self._timer.shutdown()
+        self._closed = True
+        if self._timer is not None:
+            self._timer.shutdown()
         for sub in self._subs:
             sub.unregister()
         for service in self._services:

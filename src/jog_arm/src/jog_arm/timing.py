@@ -5,19 +5,20 @@ from __future__ import annotations
 import collections
 import statistics
 
-__all__ = ["FILL_AFTER", "CycleMonitor", "timer_cycle_due"]
+__all__ = ["FILL_AFTER", "CycleMonitor", "next_fill_time"]
 
 
-# publish_on_command: the timer skips its tick while a twist ran a cycle less than this many periods ago.
-# 2: the timer stands in for a missing twist, never for a late one (a twist up to a period late gets no
-# duplicate, older command just before it, competing with it for the interpreter); once twists stop, the
-# timer runs every tick again.
-FILL_AFTER = 2.0
+# publish_on_command: twists run the cycles; a gap filler runs one this many periods after the last
+# twist-driven cycle, then one per period until twists return (halting). Above 2, so a late or single
+# missing twist never gets a duplicate, older command (the driver holds a velocity for 3 periods); the half
+# period puts its wake-ups between twists.
+FILL_AFTER = 2.5
 
 
-def timer_cycle_due(now: float, last_twist_cycle: float, period: float, publish_on_command: bool) -> bool:
-    """Whether a timer tick at `now` runs a cycle, given when a twist last ran one [s]."""
-    return not publish_on_command or now - last_twist_cycle >= FILL_AFTER * period
+def next_fill_time(last_twist_cycle: float, last_fill_cycle: float, period: float) -> float:
+    """publish_on_command: when the gap filler runs its next cycle [s], given the last cycle a twist ran and
+    the last one it ran itself."""
+    return max(last_twist_cycle + FILL_AFTER * period, last_fill_cycle + period)
 
 
 class CycleMonitor:
