@@ -9,8 +9,9 @@ from dataclasses import dataclass
 
 import pinocchio as pin
 import pytest
-from mujoco_driver.config import SceneConfig, load_scene_config
 from mujoco_driver.sim import Simulation
+
+from mujoco_driver.config import SceneConfig, load_scene_config
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SCRIPT = ROOT / "src" / "mujoco_driver" / "scripts" / "make_description"

@@ -6,6 +6,7 @@ import copy
 import pathlib
 
 import pytest
+
 from mujoco_driver.config import ConfigError, PerJoint, SceneConfig, load_scene_config
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]

@@ -8,8 +8,9 @@ import mujoco
 import numpy as np
 import pinocchio as pin
 import pytest
-from mujoco_driver.config import LinkNames
 from mujoco_driver.scene import SceneError, build_scene, mujoco_urdf, rpy_to_quat
+
+from mujoco_driver.config import LinkNames
 
 # jog_arm halts at a Jacobian condition number of 12 (spec: hard_stop_singularity_threshold).
 HARD_STOP_CONDITION = 12.0
