@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 import yaml
 from mujoco_driver.commands import trajectory_points, velocity_vector
-from mujoco_driver.pacing import Pacer, RtfMeter
+from mujoco_driver.latency import LatencyProbe
+from mujoco_driver.pacing import Pacer, RtfMeter, TrailingPublication
 from mujoco_driver.params import DriverSettings, ParamError, load_scene, urdf_root_link
 from mujoco_driver.scene import SceneError
 from mujoco_driver.sim import CommandError, Simulation
@@ -97,6 +98,53 @@ def test_rtf_meter_reports_simulated_over_wall_time_per_window_and_restarts_on_r
     assert meter.value == pytest.approx(1.0)
 
 
+def test_joint_states_go_out_half_a_period_after_the_wrench_or_before_the_next_state():
+    """The driver loop's schedule at 500 Hz with joint_states_phase 0.5: the wrench at 0, its joint states at
+    1 ms (the loop sleeps no further), nothing left pending; late, they go out before the next step."""
+    state = TrailingPublication(0.5 * 0.002)
+    assert state.armed(0.0)
+    assert not state.due(0.0002) and state.sleep_time(0.0002, wait=0.0018) == pytest.approx(0.0008)
+    assert state.due(0.001) and not state.due(0.0011)
+    assert state.sleep_time(0.0011, wait=0.0009) == pytest.approx(0.0009)
+    assert state.armed(0.002)
+    assert not state.due(0.0025, state_changes=False) and state.due(0.0025, state_changes=True)
+    assert not TrailingPublication(0.0).armed(0.0)  # phase 0 (or as fast as possible): at once
+    with pytest.raises(ValueError):
+        TrailingPublication(-1.0)
+
+
+# ---------------------------------------------------------------- latency probe
+def test_latency_probe_pairs_each_wrench_with_the_next_command():
+    probe = LatencyProbe(horizon=0.1)
+    probe.wrench_sent(1.000)
+    probe.command_received(1.0003, wall=50.0)
+    probe.command_received(1.0010, wall=50.1)  # a second command for the same wrench: not counted again
+    probe.wrench_sent(1.002)
+    probe.command_received(1.0024, wall=50.2)
+    assert probe.take() == pytest.approx([50.0, 0.0003, 50.2, 0.0004])
+    assert probe.take() == []
+
+
+def test_latency_probe_counts_a_late_command_against_every_wrench_it_was_late_for():
+    probe = LatencyProbe(horizon=0.1)
+    for t in (1.000, 1.002, 1.004):
+        probe.wrench_sent(t)
+    probe.command_received(1.0045, wall=7.0)  # errs high: 4.5, 2.5 and 0.5 ms, never the 0.5 ms alone
+    assert probe.take() == pytest.approx([7.0, 0.0045, 7.0, 0.0025, 7.0, 0.0005])
+
+
+def test_latency_probe_leaves_out_wrenches_nobody_answered_within_the_horizon():
+    probe = LatencyProbe(horizon=0.1)
+    for k in range(1000):  # two idle seconds: nothing controls the arm
+        probe.wrench_sent(k * 0.002)
+    probe.command_received(1.9985, wall=3.0)
+    samples = probe.take()
+    latencies = samples[1::2]
+    assert 45 <= len(latencies) <= 51 and max(latencies) <= 0.1 and min(latencies) == pytest.approx(0.0005)
+    with pytest.raises(ValueError):
+        LatencyProbe(horizon=0.0)
+
+
 # ---------------------------------------------------------------- params
 def test_settings_defaults_and_clock_default_from_use_sim_time():
     s = DriverSettings.from_params({"scene_config": "/x/sim.yaml"})
@@ -104,6 +152,7 @@ def test_settings_defaults_and_clock_default_from_use_sim_time():
     assert s.trajectory_command_topic == "arm_controller/command"
     assert s.velocity_command_topic == "joint_group_velocity_controller/command"
     assert s.publish_every(0.002) == 1
+    assert s.joint_states_phase == 0.5
     assert DriverSettings.from_params({"scene_config": "x"}, use_sim_time=True).publish_clock
     assert DriverSettings.from_params({"scene_config": "x", "publish_period": 0.01}).publish_every(0.002) == 5
 
@@ -124,6 +173,8 @@ def test_faster_than_real_time_needs_the_clock():
     ({"scene_config": "x", "push_timeout": "long"}, "push_timeout"),
     ({"scene_config": "x", "viewer": "yes"}, "viewer"),
     ({"scene_config": "x", "publish_period": -0.1}, "publish_period"),
+    ({"scene_config": "x", "joint_states_phase": 1.0}, "joint_states_phase"),
+    ({"scene_config": "x", "joint_states_phase": -0.1}, "joint_states_phase"),
     ({"scene_config": "x", "wrench_topic": ""}, "wrench_topic"),
     ({"scene_config": "x", "start_pose": 1.0}, "start_pose"),
     ({"scene_config": "x", "real_time_factor": math.nan}, "real_time_factor"),

@@ -121,6 +121,50 @@ def test_joint_states_name_every_joint_and_start_at_the_start_pose(ur5):
     assert np.allclose(msg.velocity, 0.0, atol=1e-3)
 
 
+def test_joint_states_carry_the_stamp_of_their_wrench_and_follow_it(ur5):
+    """joint_states_phase 0.5: the state of each instant goes out after its wrench, with the same stamp."""
+    ur5.fresh_joints(5)
+    ur5.wrench.clear()
+    joints = ur5.fresh_joints(300)
+    with ur5.joints._lock, ur5.wrench._lock:
+        joint_times = dict(zip((m.header.stamp for m in ur5.joints.msgs), ur5.joints.times, strict=True))
+        wrench_times = dict(zip((m.header.stamp for m in ur5.wrench.msgs), ur5.wrench.times, strict=True))
+    paired = [joint_times[m.header.stamp] - wrench_times[m.header.stamp]
+              for m in joints if m.header.stamp in wrench_times]
+    assert len(paired) > 250, "joint states whose stamp no wrench had"
+    gap = float(np.median(paired))
+    print(f"\njoint_states arrive {gap * 1e3:.2f} ms (median) after the wrench of the same instant")
+    assert gap > 0.0
+
+
+def test_command_latency_pairs_commands_with_the_wrenches_before_them(ur5):
+    """~command_latency: per wrench, the wait for the next joint command; nothing while nobody commands."""
+    batches = Collector(f"{NODE}/command_latency", Float64MultiArray)
+    try:
+        batches.wait_connected()
+        hold = Float64MultiArray(data=[0.0] * len(ur5.names))
+        sent_from = time.time()
+        ur5.publish_while(lambda: ur5.velocity_pub.publish(hold), lambda: len(batches.msgs) >= 2, 10,
+                          "two batches of latencies", period=0.01)
+        samples = np.concatenate([np.reshape(m.data, (-1, 2)) for m in batches.msgs])
+        dims = batches.msgs[-1].layout.dim
+        assert dims[0].size == len(batches.msgs[-1].data) // 2 and dims[1].size == 2
+        wall, latency = samples[:, 0], samples[:, 1]
+        assert np.all(wall >= sent_from - 1.0) and np.all(wall <= time.time())
+        # A command every 10 ms answers the ~5 wrenches (500 Hz) published since the one before.
+        assert np.all(latency >= 0.0) and np.all(latency <= 0.25)
+        per_command = len(latency) / len(np.unique(wall))
+        assert 2.0 < per_command < 10.0, per_command
+        # Commands stopped: after two reports (the first may carry the last commands) nothing more comes.
+        ur5.rtf.clear()
+        ur5.rtf.wait_for(2, timeout=10)
+        batches.clear()
+        ur5.rtf.wait_for(4, timeout=10)
+        assert not batches.msgs
+    finally:
+        batches.close()
+
+
 def test_wrench_at_rest_shows_the_tool_weight_in_the_sensor_frame(ur5):
     msg = ur5.wrench.wait_for(1)[-1]
     assert msg.header.frame_id == "ft_sensor"

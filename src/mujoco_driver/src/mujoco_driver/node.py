@@ -26,13 +26,14 @@ from geometry_msgs.msg import PoseStamped, WrenchStamped
 from rosgraph_msgs.msg import Clock
 from rospy.rostime import _set_rostime
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64, Float64MultiArray
+from std_msgs.msg import Float64, Float64MultiArray, MultiArrayDimension
 from std_srvs.srv import Trigger, TriggerResponse
 from trajectory_msgs.msg import JointTrajectory
 
 from mujoco_driver.commands import trajectory_points, velocity_vector
 from mujoco_driver.config import ConfigError, SceneConfig
-from mujoco_driver.pacing import Pacer, RtfMeter
+from mujoco_driver.latency import LatencyProbe
+from mujoco_driver.pacing import Pacer, RtfMeter, TrailingPublication
 from mujoco_driver.params import DriverSettings, ParamError, load_scene, urdf_root_link
 from mujoco_driver.scene import SceneError
 from mujoco_driver.sim import CommandError, Simulation
@@ -86,6 +87,11 @@ class MujocoDriverNode:
         self._clock_msg = Clock()
         self._rtf_msg = Float64()
         self._stamp = rospy.Time()
+        self._state_stamp = rospy.Time()  # the pending joint state's (the shared one moves with /clock)
+        self._latency = LatencyProbe(horizon=s.command_timeout)
+        self._latency_msg = Float64MultiArray()
+        self._latency_msg.layout.dim = [MultiArrayDimension("command", 0, 0),
+                                        MultiArrayDimension("received_wall_time_and_latency", 2, 2)]
 
         # rospy's Publisher does take tcp_nodelay (TCP_NODELAY on the publisher's socket; subscribers may ask
         # for it too). With a queue_size, publish() hands the bytes to a writer thread per subscriber, so a
@@ -101,6 +107,7 @@ class MujocoDriverNode:
         self._wrench_pub = publisher(s.wrench_topic, WrenchStamped)
         self._pose_pub = publisher("~eef_pose", PoseStamped)
         self._rtf_pub = publisher("~rtf", Float64)
+        self._latency_pub = publisher("~command_latency", Float64MultiArray)
         self._clock_pub = publisher("/clock", Clock) if s.publish_clock else None
         if self._clock_pub is not None and getattr(simtime, "_clock_sub", None) is not None:
             simtime._clock_sub.unregister()  # see _publish_clock
@@ -144,18 +151,27 @@ class MujocoDriverNode:
         meter = RtfMeter(s.rtf_period)
         countdown = 0
         next_view = 0.0
+        # joint_states trail the wrench by a fraction of the wall-clock publish period (0 when running as fast
+        # as possible).
+        state = TrailingPublication(s.joint_states_phase * pacer.period * self._publish_every)
         pacer.start(time.monotonic())
         self._read_state()
         while not (self._stop_requested or rospy.is_shutdown()):
-            wait = pacer.wait_time(time.monotonic())
+            now = time.monotonic()
+            if state.due(now):
+                self._publish_state()
+                continue
+            wait = pacer.wait_time(now)
             if wait > 0.0:
-                time.sleep(wait)  # ahead of the wall clock: the only sleep, never while catching up
+                time.sleep(state.sleep_time(now, wait))  # ahead of the wall clock: never while catching up
                 continue
             countdown -= 1
             # Catching up after a stall: step without publishing the intermediate states (publishing costs
             # several times the physics), so the simulation is back on time sooner; the newest state goes out.
             catching_up = pacer.lag(time.monotonic()) > pacer.period
             publish = countdown <= 0 and not catching_up
+            if state.due(now, state_changes=publish):
+                self._publish_state()
             with self._lock:
                 self._watchdog()
                 sim.step()
@@ -168,7 +184,9 @@ class MujocoDriverNode:
                 self._publish_clock()
             if publish:
                 countdown = self._publish_every
-                self._publish()
+                self._publish_wrench()
+                if not state.armed(time.monotonic()):
+                    self._publish_state()
             now = time.monotonic()
             if meter.update(now, self._clock_offset + self._sim_time):
                 self._report(meter.value, pacer.dropped)
@@ -216,16 +234,21 @@ class MujocoDriverNode:
         # hands the object itself to callers of rospy.Time.now().
         _set_rostime(rospy.Time(self._stamp.secs, self._stamp.nsecs))
 
-    def _publish(self) -> None:
+    def _publish_wrench(self) -> None:
+        """The wrench of the state just read: it starts the force-control chain, so it goes out first."""
         self._set_stamp()
-        # The wrench first: it starts the force-control chain, the joint states only feed it.
         w, msg = self._w, self._wrench_msg
         msg.header.stamp = self._stamp
         f, t = msg.wrench.force, msg.wrench.torque
         f.x, f.y, f.z, t.x, t.y, t.z = w.tolist()
+        self._state_stamp.secs, self._state_stamp.nsecs = self._stamp.secs, self._stamp.nsecs
+        self._latency.wrench_sent(time.monotonic())
         self._wrench_pub.publish(msg)
+
+    def _publish_state(self) -> None:
+        """Joint states (and every few times the EEF pose) of the state the last wrench came from."""
         joint = self._joint_msg
-        joint.header.stamp = self._stamp
+        joint.header.stamp = self._state_stamp
         # Lists serialise fastest in genpy (numpy scalars go through a slower path).
         joint.position, joint.velocity, joint.effort = self._q.tolist(), self._qd.tolist(), self._tau.tolist()
         self._joint_pub.publish(joint)
@@ -234,7 +257,7 @@ class MujocoDriverNode:
             return
         self._pose_countdown = self._pose_every
         pose = self._pose_msg
-        pose.header.stamp = self._stamp
+        pose.header.stamp = self._state_stamp
         p, o = pose.pose.position, pose.pose.orientation
         p.x, p.y, p.z = self._xpos.tolist()
         o.w, o.x, o.y, o.z = self._xquat.tolist()  # MuJoCo quaternions are (w, x, y, z)
@@ -243,6 +266,12 @@ class MujocoDriverNode:
     def _report(self, rtf: float, dropped: float) -> None:
         self._rtf_msg.data = rtf
         self._rtf_pub.publish(self._rtf_msg)
+        latencies = self._latency.take()
+        if latencies and self._latency_pub.get_num_connections() > 0:
+            msg = self._latency_msg
+            msg.layout.dim[0].size, msg.layout.dim[0].stride = len(latencies) // 2, len(latencies)
+            msg.data = latencies
+            self._latency_pub.publish(msg)
         target = self._s.real_time_factor
         rospy.logdebug("mujoco_driver: real-time factor %.3f", rtf)
         if target > 0.0 and rtf < 0.9 * target:
@@ -286,6 +315,7 @@ class MujocoDriverNode:
             rospy.logwarn(f"mujoco_driver: {what} ignored: {exc}")
 
     def _on_trajectory(self, msg: JointTrajectory) -> None:
+        self._latency.command_received(time.monotonic(), time.time())
         raw = [(p.positions, p.velocities, p.time_from_start.to_sec()) for p in msg.points]
         stamp = msg.header.stamp.to_sec()
         with self._lock:
@@ -311,6 +341,7 @@ class MujocoDriverNode:
             self._velocity_active = False
 
     def _on_velocity(self, msg: Float64MultiArray) -> None:
+        self._latency.command_received(time.monotonic(), time.time())
         with self._lock:
             sim = self._sim
             try:

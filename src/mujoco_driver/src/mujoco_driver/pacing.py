@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["Pacer", "RtfMeter"]
+__all__ = ["Pacer", "RtfMeter", "TrailingPublication"]
 
 
 class Pacer:
@@ -96,3 +96,38 @@ class RtfMeter:
         self.value = (sim_time - self._sim0) / elapsed
         self._wall0, self._sim0 = wall, sim_time
         return True
+
+
+class TrailingPublication:
+    """When a publication that trails another goes out: the joint states, `delay` after the wrench of the same
+    state, or before the next step that reads a new state, whichever comes first.
+
+    Args:
+        delay: Wall-clock delay [s]; 0 publishes at once (:meth:`armed` then answers False).
+    """
+
+    def __init__(self, delay: float) -> None:
+        if not (math.isfinite(delay) and delay >= 0.0):
+            raise ValueError(f"delay must be >= 0, got {delay}")
+        self.delay = delay
+        self._due: float | None = None
+
+    def armed(self, now: float) -> bool:
+        """The leading publication went out at `now`: True if the trailing one is now pending, False if it is
+        to go out at once."""
+        if self.delay == 0.0:
+            return False
+        self._due = now + self.delay
+        return True
+
+    def due(self, now: float, state_changes: bool = False) -> bool:
+        """Whether the pending publication goes out now (then it is no longer pending): its time has come, or
+        the next step (`state_changes`) would overwrite what it publishes."""
+        if self._due is None or not (state_changes or now >= self._due):
+            return False
+        self._due = None
+        return True
+
+    def sleep_time(self, now: float, wait: float) -> float:
+        """How long to sleep when the next step is `wait` away: no later than the pending publication."""
+        return wait if self._due is None else max(min(wait, self._due - now), 0.0)

@@ -33,6 +33,9 @@ class DriverSettings:
         real_time_factor: Simulated seconds per wall-clock second; 0 = as fast as possible.
         publish_clock: Publish rosgraph_msgs/Clock on /clock and stamp everything with simulated time.
         publish_period: Period of joint_states and wrench [s]; 0 = every simulation step.
+        joint_states_phase: joint_states (and ~eef_pose) go out this fraction of the publish period after the
+            wrench of the same instant (same stamp); 0 = right after it. Keeps the wake-ups they cause in
+            other processes out of the way of the wrench-to-command chain.
         eef_pose_period: Period of ~eef_pose [s] (ground truth for plots); 0 = with joint_states.
         command_timeout: Velocity target back to zero this long after the last velocity command [s].
         push_timeout: A ~push_wrench push ends this long after its last message [s].
@@ -53,6 +56,7 @@ class DriverSettings:
     real_time_factor: float = 1.0
     publish_clock: bool = False
     publish_period: float = 0.0
+    joint_states_phase: float = 0.5
     eef_pose_period: float = 0.01
     command_timeout: float = 0.1
     push_timeout: float = 0.2
@@ -132,6 +136,9 @@ class DriverSettings:
         for key in ("publish_period", "eef_pose_period"):
             if getattr(self, key) < 0.0:
                 raise ParamError(f"~{key}: must be >= 0, got {getattr(self, key)}")
+        if not 0.0 <= self.joint_states_phase < 1.0:
+            raise ParamError("~joint_states_phase: must be in [0, 1) (a fraction of the publish period), "
+                             f"got {self.joint_states_phase}")
         for key in ("command_timeout", "push_timeout", "max_lag", "rtf_period", "viewer_period"):
             if not getattr(self, key) > 0.0:
                 raise ParamError(f"~{key}: must be > 0, got {getattr(self, key)}")
