@@ -71,6 +71,17 @@ def test_push_shows_on_the_sensor_while_it_lasts_and_the_arm_barely_moves(sim, a
     assert np.linalg.norm(sim.eef_pose()[0] - tip) < 1e-4
 
 
+def test_push_goes_on_when_something_clears_the_applied_forces_between_steps(sim):
+    """MuJoCo's passive viewer zeroes data.xfrc_applied (its mouse-perturbation channel) at every sync."""
+    sim.push([10.0, 0.0, 0.0], duration=0.5)
+    steps(sim, 0.1)
+    for _ in range(10):  # a viewer syncing at 50 Hz
+        sim.data.xfrc_applied[:] = 0.0
+        steps(sim, 0.02)
+    force, _ = world_wrench(sim)
+    np.testing.assert_allclose(force - tool_weight(sim), [10.0, 0.0, 0.0], atol=1.0)
+
+
 def test_push_torque_about_the_sensor(sim):
     sim.push([0.0, 0.0, 0.0], torque=[0.0, 0.0, 2.0], duration=1.0)
     steps(sim, 0.5)

@@ -104,6 +104,7 @@ class Simulation:
         self._traj: tuple[float, np.ndarray, np.ndarray, np.ndarray, bool] | None = None
         self._traj_seg = 0
         self._push_steps = 0
+        self._push_wrench = np.zeros(6)
         self._rng = np.random.default_rng(cfg.wrench_noise.seed)
         self.reset()
 
@@ -307,6 +308,7 @@ class Simulation:
         if not math.isfinite(duration) or duration < 0.0:
             raise CommandError(f"push: duration must be >= 0 s, got {duration}")
         self._push_steps = round(duration / self.dt)
+        self._push_wrench[:] = wrench
         self.data.xfrc_applied[self.scene.tool_body] = wrench if self._push_steps else 0.0
 
     def reset(self) -> None:
@@ -332,6 +334,8 @@ class Simulation:
         for _ in range(n):
             self._update_setpoint()
             self._write_controls()
+            if self._push_steps:  # every step: the viewer's sync() zeroes xfrc_applied (its mouse channel)
+                data.xfrc_applied[self.scene.tool_body] = self._push_wrench
             mujoco.mj_step2(model, data)
             if self._push_steps:
                 self._push_steps -= 1

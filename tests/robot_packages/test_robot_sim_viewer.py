@@ -1,0 +1,82 @@
+"""`roslaunch ur5_custom sim.launch viewer:=true` with a display (a private Xvfb, Mesa's software OpenGL):
+MuJoCo's window opens, the arm still complies with a push while it is open, and the stack shuts down
+cleanly with the window still open."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+pytest.importorskip("cartesian_impedance_msgs.srv", reason="needs devel/setup.bash (make test sources it)")
+
+from cartesian_impedance_msgs.msg import ControlLaw
+from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
+from compliant_control_msgs.srv import PushEEF, PushEEFRequest
+from geometry_msgs.msg import PoseStamped
+from harness.launch import run_launch
+from harness.waiting import Collector, wait_until
+
+pytestmark = pytest.mark.skipif(not (shutil.which("Xvfb") and shutil.which("xwininfo")),
+                                reason="needs Xvfb and xwininfo (scripts/bootstrap installs xvfb, x11-utils)")
+
+
+@pytest.fixture
+def display():
+    """A private X display; Xvfb picks a free number itself (-displayfd), so runs cannot collide."""
+    read_end, write_end = os.pipe()
+    xvfb = subprocess.Popen(["Xvfb", "-displayfd", str(write_end), "-screen", "0", "1024x768x24",
+                             "-nolisten", "tcp"], pass_fds=(write_end,), stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    os.close(write_end)
+    try:
+        with os.fdopen(read_end) as pipe:
+            number = pipe.readline().strip()  # written once the server accepts connections
+        assert number, "Xvfb did not start"
+        yield f":{number}"
+    finally:
+        xvfb.terminate()
+        xvfb.wait(timeout=10)
+
+
+def _windows(display: str) -> str:
+    return subprocess.run(["xwininfo", "-root", "-tree"], capture_output=True, text=True, timeout=10,
+                          env={**os.environ, "DISPLAY": display}).stdout
+
+
+def test_viewer_opens_a_window_and_the_arm_still_complies(ros_node, display):
+    rospy = ros_node
+    env = {**os.environ, "DISPLAY": display}
+    env.pop("WAYLAND_DISPLAY", None)
+    with run_launch("ur5_custom", "sim.launch", args={"viewer": "true"}, env=env) as h:
+        h.wait_for_topic("/mujoco_driver/eef_pose", timeout=40)
+        h.wait_for_service("/configure_cartesian_impedance", timeout=40)
+        wait_until(lambda: "MuJoCo" in _windows(display), 20, "MuJoCo's window on the display")
+        assert "running headless" not in h.output(), h.output()[-3000:]
+
+        pose = Collector("/mujoco_driver/eef_pose", PoseStamped)
+        try:
+            pose.wait_for(1, timeout=20)
+
+            def tip() -> np.ndarray:
+                p = pose.last().pose.position
+                return np.array([p.x, p.y, p.z])
+
+            req = ConfigureForceControlRequest()
+            req.cart_impedance_params.damping.translational.x = 200.0
+            req.direction_control_laws.x.type = ControlLaw.TYPE_FOLLOWER
+            assert rospy.ServiceProxy("/configure_cartesian_impedance", ConfigureForceControl)(req).success
+            before = tip()
+            push = PushEEFRequest(duration=0.6)
+            push.wrench.force.x = -10.0
+            assert rospy.ServiceProxy("/mujoco_driver/push", PushEEF)(push).success
+            wait_until(lambda: before[0] - tip()[0] > 0.01, 10, "the tool to follow the push along -X")
+        finally:
+            pose.close()
+        assert "MuJoCo" in _windows(display), "the window closed by itself"
+        h.stop()
+        assert h.proc.returncode == 0, h.output()[-3000:]
+        assert "escalating" not in h.output(), "a node needed SIGTERM/SIGKILL to stop"
