@@ -4,6 +4,7 @@ push, and everything shuts down cleanly."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import xmlrpc.client
 
@@ -31,6 +32,29 @@ NODES = ("/mujoco_driver", "/control_stack", "/jog_arm_server", "/contact_contro
          "/robot_state_publisher")
 
 
+MESSAGES = {"/mujoco_driver/eef_pose": PoseStamped, "/joint_states": JointState, "/wrench": WrenchStamped,
+            "/contact_control_node/status": ContactControlStatus}
+
+
+@contextlib.contextmanager
+def _clients(rospy, *topics: str):
+    """Collectors on `topics` (each holding a first message), then a publisher into jog_arm's input (the
+    keyboard's path) once jog_arm listens; all closed on exit. Few subscribers: on 2 cores this process's
+    load delays the stack's messages."""
+    collectors = [Collector(topic, MESSAGES[topic]) for topic in topics]
+    twist_pub = rospy.Publisher("/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1,
+                                tcp_nodelay=True)
+    try:
+        for c in collectors:
+            c.wait_for(1, timeout=20)
+        wait_until(lambda: twist_pub.get_num_connections() > 0, 10, "jog_arm to subscribe to its input")
+        yield (*collectors, twist_pub)
+    finally:
+        for c in collectors:
+            c.close()
+        twist_pub.unregister()
+
+
 def _registered_nodes() -> set[str]:
     code, _, state = xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"]).getSystemState("/probe")
     assert code == 1
@@ -46,18 +70,10 @@ def test_sim_stack_comes_up_jogs_follows_a_push_and_shuts_down(ros_node, robot, 
             h.wait_for_topic(topic, timeout=40)
         for service in SERVICES:
             h.wait_for_service(service, timeout=40)
-        # Few subscribers in this process: on 2 cores its load delays the stack's messages.
-        pose = Collector("/mujoco_driver/eef_pose", PoseStamped)
-        joints = Collector("/joint_states", JointState)
-        cc_status = Collector("/contact_control_node/status", ContactControlStatus)
-        twist_pub = rospy.Publisher("/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1,
-                                    tcp_nodelay=True)
-        try:
-            for c in (pose, joints, cc_status):
-                c.wait_for(1, timeout=20)
+        clients = _clients(rospy, "/mujoco_driver/eef_pose", "/joint_states", "/contact_control_node/status")
+        with clients as (pose, joints, cc_status, twist_pub):
             rospy.wait_for_message("/wrench", WrenchStamped, timeout=10)
             rospy.wait_for_message("/jog_arm_server/status", JogStatus, timeout=10)
-            wait_until(lambda: twist_pub.get_num_connections() > 0, 10, "jog_arm to subscribe to its input")
 
             def tip() -> np.ndarray:
                 p = pose.last().pose.position
@@ -100,10 +116,6 @@ def test_sim_stack_comes_up_jogs_follows_a_push_and_shuts_down(ros_node, robot, 
             settle()
             assert np.all(np.abs(moved[1:]) < 0.25 * abs(moved[0])), f"the follower left the X axis: {moved}"
             print(f"\n{robot}: jogged 2 cm along -X; the follower gave way to a 10 N push along -X")
-        finally:
-            for c in (pose, joints, cc_status):
-                c.close()
-            twist_pub.unregister()
         h.stop()
         assert h.proc.returncode == 0, h.output()[-3000:]
         assert "escalating" not in h.output(), "a node needed SIGTERM/SIGKILL to stop"
@@ -126,16 +138,8 @@ def test_reoriented_tool_stays_put_under_a_follower(ros_node, robot):
         for topic in ("/mujoco_driver/eef_pose", "/wrench"):
             h.wait_for_topic(topic, timeout=40)
         h.wait_for_service("/configure_cartesian_impedance", timeout=40)
-        pose = Collector("/mujoco_driver/eef_pose", PoseStamped)
-        wrench = Collector("/wrench", WrenchStamped)
-        cc_status = Collector("/contact_control_node/status", ContactControlStatus)
-        twist_pub = rospy.Publisher("/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1,
-                                    tcp_nodelay=True)
-        try:
-            for c in (pose, wrench, cc_status):
-                c.wait_for(1, timeout=20)
-            wait_until(lambda: twist_pub.get_num_connections() > 0, 10, "jog_arm to subscribe to its input")
-
+        clients = _clients(rospy, "/mujoco_driver/eef_pose", "/wrench", "/contact_control_node/status")
+        with clients as (pose, wrench, cc_status, twist_pub):
             def force(msg: WrenchStamped) -> np.ndarray:
                 f = msg.wrench.force
                 return np.array([f.x, f.y, f.z])
@@ -179,7 +183,3 @@ def test_reoriented_tool_stays_put_under_a_follower(ros_node, robot):
             print(f"\n{robot}: tilted 0.5 rad, the weight moved {shift:.1f} N on the sensor; compensated "
                   f"residual <= {residual:.2f} N; the follower drifted {drift * 1e3:.2f} mm in 2 s")
             assert rospy.ServiceProxy("/contact_control_node/stop", Trigger)().success
-        finally:
-            for c in (pose, wrench, cc_status):
-                c.close()
-            twist_pub.unregister()
