@@ -50,6 +50,11 @@ class Collector:
         """Waits until a publisher is connected."""
         wait_until(lambda: self._sub.get_num_connections() > 0, timeout, f"a publisher on {self._sub.name}")
 
+    def timed(self) -> list[tuple[float, object]]:
+        """(receive time, message) of everything collected so far."""
+        with self._lock:
+            return list(zip(self.times, self.msgs, strict=True))
+
     def last(self):
         with self._lock:
             return self.msgs[-1] if self.msgs else None

@@ -125,12 +125,10 @@ def test_joint_states_carry_the_stamp_of_their_wrench_and_follow_it(ur5):
     """joint_states_phase 0.5: the state of each instant goes out after its wrench, with the same stamp."""
     ur5.fresh_joints(5)
     ur5.wrench.clear()
-    joints = ur5.fresh_joints(300)
-    with ur5.joints._lock, ur5.wrench._lock:
-        joint_times = dict(zip((m.header.stamp for m in ur5.joints.msgs), ur5.joints.times, strict=True))
-        wrench_times = dict(zip((m.header.stamp for m in ur5.wrench.msgs), ur5.wrench.times, strict=True))
-    paired = [joint_times[m.header.stamp] - wrench_times[m.header.stamp]
-              for m in joints if m.header.stamp in wrench_times]
+    ur5.fresh_joints(300)
+    wrench_times = {m.header.stamp: t for t, m in ur5.wrench.timed()}
+    paired = [t - wrench_times[m.header.stamp]
+              for t, m in ur5.joints.timed() if m.header.stamp in wrench_times]
     assert len(paired) > 250, "joint states whose stamp no wrench had"
     gap = float(np.median(paired))
     print(f"\njoint_states arrive {gap * 1e3:.2f} ms (median) after the wrench of the same instant")
