@@ -18,6 +18,7 @@ pytest.importorskip("cartesian_impedance_msgs.srv", reason="needs devel/setup.ba
 from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
 from geometry_msgs.msg import TwistStamped, WrenchStamped
 from harness.launch import run_node
+from harness.streams import Repeater
 from harness.waiting import Collector, wait_until
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
@@ -54,7 +55,7 @@ def test_one_joint_command_per_twist_in_the_push_direction_with_the_usual_servic
     rospy.set_param(f"{NS}/contact_control_node", CONTACT)
     model = ArmModel(UR5.urdf, UR5.tip)
     joints = rospy.Publisher(f"{NS}/joint_states", JointState, queue_size=1, latch=True)
-    joints.publish(JointState(name=list(model.joint_names), position=list(UR5.start)))
+    driver = Repeater(joints).start(JointState(name=list(model.joint_names), position=list(UR5.start)), 100.0)
     wrench = rospy.Publisher(f"{NS}/wrench", WrenchStamped, queue_size=10, tcp_nodelay=True)
     twists, commands = Collector(TWIST, TwistStamped), Collector(COMMAND, Float64MultiArray)
     try:
@@ -98,5 +99,6 @@ def test_one_joint_command_per_twist_in_the_push_direction_with_the_usual_servic
     finally:
         for c in (twists, commands):
             c.close()
+        driver.stop()
         joints.unregister()
         wrench.unregister()

@@ -13,6 +13,7 @@ import pinocchio as pin
 import pytest
 from harness.bags import replay_bag, typestore, write_bag
 from harness.launch import run_launch, run_node
+from harness.streams import Repeater
 from harness.waiting import Collector, wait_until
 from jog_arm_testing import PANDA, UR5, angle_deg
 
@@ -75,34 +76,13 @@ def panda_params(**extra) -> dict:
     }
 
 
-class Sender:
+class Sender(Repeater):
     """Publishes a twist at a steady rate from a thread until stopped (a teleop device)."""
 
     def __init__(self, rospy, topic: str) -> None:
         from geometry_msgs.msg import TwistStamped
 
-        self._rospy = rospy
-        self.pub = rospy.Publisher(topic, TwistStamped, queue_size=1, tcp_nodelay=True)
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
-
-    def start(self, msg, rate: float = 50.0) -> None:
-        self.stop()
-        self._stop.clear()
-
-        def loop() -> None:
-            while not self._stop.is_set():
-                self.pub.publish(msg)
-                self._stop.wait(1.0 / rate)
-
-        self._thread = threading.Thread(target=loop, daemon=True)
-        self._thread.start()
-
-    def stop(self) -> None:
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join()
-            self._thread = None
+        super().__init__(rospy.Publisher(topic, TwistStamped, queue_size=1, tcp_nodelay=True))
 
 
 @contextlib.contextmanager
@@ -233,7 +213,7 @@ def test_velocity_output_tf_frame_pause_and_launch_file(ros_node, tmp_path) -> N
     model = ArmModel(UR5.urdf, UR5.tip)
     joints = rospy.Publisher("/jog_ur5/joint_states", JointState, queue_size=1, latch=True)
     state = JointState(name=list(model.joint_names), position=list(UR5.start))
-    joints.publish(state)
+    driver = Repeater(joints).start(state, rate=100.0)  # a driver streams its state (joint_state_timeout)
     speeds = Collector("/jog_ur5/speed", Float64MultiArray)
     name = "jog_test_ur5"
     status = Collector(f"/{name}/status", JogStatus)
@@ -263,6 +243,7 @@ def test_velocity_output_tf_frame_pause_and_launch_file(ros_node, tmp_path) -> N
             sender.stop()
             speeds.close()
             status.close()
+            driver.stop()
             joints.unregister()
 
 
@@ -290,7 +271,8 @@ def ur5_server(rospy, name: str, prefix: str, params: dict, out_class: type):
     }
     set_params(rospy, name, {"command_in_type": "speed_units", **topics, **params})
     joints = rospy.Publisher(topics["joint_topic"], JointState, queue_size=1, latch=True)
-    joints.publish(JointState(name=list(ArmModel(UR5.urdf, UR5.tip).joint_names), position=list(UR5.start)))
+    state = JointState(name=list(ArmModel(UR5.urdf, UR5.tip).joint_names), position=list(UR5.start))
+    driver = Repeater(joints).start(state, rate=100.0)  # a driver streams its state (joint_state_timeout)
     commands = Collector(topics["cmd_out_topic"], out_class)
     sender = Sender(rospy, topics["cmd_in_topic"])
     with run_node("jog_arm", "jog_arm_server", name=name) as node, node_log_on_failure(node):
@@ -301,6 +283,7 @@ def ur5_server(rospy, name: str, prefix: str, params: dict, out_class: type):
         finally:
             sender.stop()
             commands.close()
+            driver.stop()
             joints.unregister()
 
 

@@ -155,6 +155,7 @@ class ContactControl:
         self._timeout = s.wrench_timeout
         self._end_timeout = s.no_data_end_timeout
         self._check_age = s.check_stamp_age
+        self._future = s.future_stamp_tolerance
         self._dt_nominal = 1.0 / s.control_rate
         self._diff = tuple(t.diff_max for t in self._tuning)
         self._windows = [ForceWindow(s.diff_window) for _ in range(6)]
@@ -164,6 +165,7 @@ class ContactControl:
         self._armed = [True] * 6
         self._from_rest: float | None = None  # when the axes last started from rest
         self._meter = TravelMeter(s.travel_directions)
+        self._travel_offset = [0.0] * 6  # travel of an axis whose law changed during a move, at the change
         self._laws: list[AxisLaw] = [AxisLaw()] * 6
         self._law_types = [LAW_NONE] * 6
         self._active: tuple[int, ...] = ()
@@ -254,8 +256,13 @@ class ContactControl:
             raise ValueError("set_laws needs six AxisLaw (x, y, z, rx, ry, rz)")
         if self._latched:
             raise RequestError(FAILURE, f"safety latched ({self._latch_message}); call reset first")
+        if self._move_active and any(law.law for law in laws):
+            if laws == self._laws:  # a re-sent request (GUI Apply held, a script in a loop): nothing changes
+                return self._move_id
+            return self._change_laws(laws, t)
         if self._move_active:
             self._end_move(-1, END_EXTERNAL_STOP, False, "replaced by a new request")
+        self._travel_offset = [0.0] * 6
         self._laws = laws
         self._law_types = [law.law for law in laws]
         self._active = tuple(i for i in range(6) if laws[i].law != LAW_NONE)
@@ -281,6 +288,48 @@ class ContactControl:
         if not self._active:
             self._outcomes[self._move_id] = True
         return self._move_id
+
+    def _change_laws(self, laws: list[AxisLaw], t: float | None) -> int:
+        """Bumpless re-configuration of a running move: an axis that keeps its law type keeps its velocity,
+        travel and force-limit arming (new parameters apply from its current state, within the rate limits);
+        an axis whose law changes starts from rest, its travel from here. The move gets a new id (a blocking
+        caller of the old request is answered), but nothing stops."""
+        old, kept = self._law_types, list(self._v)
+        self._end_move(-1, END_EXTERNAL_STOP, False, "changed by a new request")
+        self._v = kept
+        for i, law in enumerate(laws):
+            if law.law != old[i] or not law.law:
+                self._v[i] = 0.0
+                self._travel_offset[i] = self._travel[i] + self._travel_offset[i]
+                self._travel[i] = 0.0
+                self._windows[i].clear()
+                self._armed[i] = self._arm_time <= 0.0
+        if not all(self._armed):
+            self._from_rest = t
+        self._laws = laws
+        self._law_types = [law.law for law in laws]
+        self._active = tuple(i for i in range(6) if laws[i].law != LAW_NONE)
+        self._diff_axes = tuple(i for i in self._active if self._diff[i] > 0.0)
+        self._needs_travel = any(law.law != LAW_FOLLOWER or law.max_travel > 0.0 for law in laws if law.law)
+        self._end = [END_NONE] * 6
+        self._ended_axis = -1
+        self._move_id += 1
+        self._move_active = True
+        self._end_ok = True
+        self._end_message = ""
+        return self._move_id
+
+    def clock_jumped(self, t: float, description: str) -> CycleResult:
+        """The clock jumped (see compliant_common.clock): every duration measured across it is wrong, so the
+        output halts and the timing restarts at `t` (no wrench counts as received, the no-data end timeout and
+        force-limit arming restart); the move resumes with the next wrench stamped after the jump."""
+        self._last_rx = None
+        self._last_t = None
+        if self._move_active:
+            self._move_t0 = t
+        for window in self._windows:
+            window.clear()
+        return self._hold(t, SAFETY_STALE, f"{description}: timing reset, holding until fresh data")
 
     def stop(self, reason: str = "stop requested") -> bool:
         """Ends the running move (EXTERNAL_STOP); returns whether one was running."""
@@ -332,10 +381,14 @@ class ContactControl:
             R_fixed_control: control frame orientation at the move's start, used if the start is taken now.
             stamp: the wrench's header time [s] or None; older than wrench_timeout counts as no data.
         """
-        if stamp is not None and self._check_age and t - stamp > self._timeout:
-            return self._hold(
-                t, SAFETY_STALE, f"wrench stamp is {t - stamp:.3f} s old (wrench_timeout {self._timeout} s)"
-            )
+        if stamp is not None and self._check_age:
+            if t - stamp > self._timeout:
+                age = f"wrench stamp is {t - stamp:.3f} s old (wrench_timeout {self._timeout} s)"
+                return self._hold(t, SAFETY_STALE, age)
+            if stamp - t > self._future:  # another clock, or data from before a backward clock jump
+                self._last_rx = t
+                ahead = f"wrench stamped {stamp - t:.3f} s ahead (future_stamp_tolerance {self._future} s)"
+                return self._hold(t, SAFETY_NAN, f"{ahead}: holding until data stamped by this node's clock")
         self._last_rx = t
         if self._tare_pending and is_finite6(wrench):
             self.preprocessor.tare(wrench, R_world_sensor)
@@ -356,6 +409,10 @@ class ContactControl:
             if not self._meter.started:
                 self._meter.start(eef_pose, R_fixed_control)
             self._meter.measure(eef_pose, travel)
+            offset = self._travel_offset
+            if any(offset):
+                for i in range(6):
+                    travel[i] -= offset[i]
         laws = self._laws
         armed = self._armed
         for i in self._active:

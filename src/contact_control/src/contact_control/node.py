@@ -11,7 +11,6 @@ sources (keyboard jogging) can use the same topic in between.
 from __future__ import annotations
 
 import contextlib
-import gc
 import sys
 import threading
 from collections.abc import Callable, Sequence
@@ -21,6 +20,10 @@ import rospy
 import tf2_ros
 from cartesian_impedance_msgs.msg import CartesianForceCtrlErrorCodes
 from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlResponse
+from compliant_common.clock import ClockJump
+from compliant_common.master import MasterWatch
+from compliant_common.ros_time import JumpAwareClock, sleep_through_jumps, timer
+from compliant_common.runtime import tune_runtime
 from compliant_control_msgs.msg import AxisState, ContactControlStatus
 from geometry_msgs.msg import TwistStamped, WrenchStamped
 from std_srvs.srv import Trigger, TriggerResponse
@@ -40,7 +43,7 @@ from contact_control.params import PARAMETERS, ContactControlSettings, ParamErro
 from contact_control.preprocess import PreprocessError
 from contact_control.request import RequestError, RequestLimits, validate_request
 
-__all__ = ["ContactControlNode", "main", "read_settings", "tune_runtime"]
+__all__ = ["ContactControlNode", "main", "read_settings"]
 
 _ZERO = (0.0,) * 6
 _TF_ERRORS = (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException)
@@ -95,6 +98,8 @@ class ContactControlNode:
         self._idle_zeros = 0
         self._was_active = False
         self._request_note = ""
+        self._fault_note = ""  # a clock jump or a lost master, for ~status until it is over
+        self._clock = JumpAwareClock()
         self._twist_sink = twist_sink
         self._own_subscribers = own_subscribers
         self._twist = TwistStamped()
@@ -122,7 +127,7 @@ class ContactControlNode:
             s.ft_in_topic, WrenchStamped, self._on_wrench, queue_size=1, tcp_nodelay=True
         )
         threading.Thread(target=self._watch_staleness, name="contact_control_staleness", daemon=True).start()
-        self._status_timer = rospy.Timer(rospy.Duration(1.0 / s.status_rate), self._on_status)
+        self._status_timer = timer(1.0 / s.status_rate, self._on_status)
         rospy.on_shutdown(self._on_shutdown)
 
     # --- tf ---
@@ -192,7 +197,10 @@ class ContactControlNode:
 
     # --- cycles ---
     def _on_wrench(self, msg: WrenchStamped) -> None:
-        t = rospy.get_time()
+        t, jump = self._clock.read()
+        if jump is not None:
+            self._on_clock_jump(jump, t)
+            return
         f, q = msg.wrench.force, msg.wrench.torque
         wrench = (f.x, f.y, f.z, q.x, q.y, q.z)
         stamp = msg.header.stamp.to_sec() if not msg.header.stamp.is_zero() else None
@@ -214,16 +222,44 @@ class ContactControlNode:
         wake the process control_rate times a second for nothing."""
         period = 1.0 / self._s.control_rate
         while not rospy.is_shutdown():
-            with self._lock:
-                t = rospy.get_time()
-                result = self._ctrl.check_stale(t)
-                if result is not None:
-                    self._publish(result, t)
-                wait = period if result is not None else max(self._ctrl.fresh_until - t, period)
+            t, jump = self._clock.read()
+            if jump is not None:
+                self._on_clock_jump(jump, t)
+                wait = period
+            else:
+                with self._lock:
+                    result = self._ctrl.check_stale(t)
+                    if result is not None:
+                        self._publish(result, t)
+                    wait = period if result is not None else max(self._ctrl.fresh_until - t, period)
             try:
-                rospy.sleep(wait)
+                sleep_through_jumps(wait)  # a backward jump ends it early; the next reading reports it
             except rospy.ROSInterruptException:
                 return
+
+    def _on_clock_jump(self, jump: ClockJump, t: float) -> None:
+        """Halts and restarts the timing; the move resumes with the next wrench stamped after the jump."""
+        note = jump.describe()
+        rospy.logwarn("contact_control: %s: holding (zero twist) until fresh data", note)
+        with self._lock:
+            self._fault_note = note
+            self._publish(self._ctrl.clock_jumped(t, note), t)
+
+    # --- master ---
+    def on_master_lost(self, reason: str) -> None:
+        """The graph is broken: the running move ends and zero twists go out on the existing connections."""
+        rospy.logerr("contact_control: %s: ending the move and holding still until it returns", reason)
+        with self._lock:
+            self._fault_note = reason
+            if self._ctrl.stop(reason):
+                self._move_ended.notify_all()
+                self._was_active = False
+                self._idle_zeros = int(self._s.idle_zero_count)
+                self._send(_ZERO, rospy.get_time())
+
+    def on_master_back(self) -> None:
+        with self._lock:
+            self._fault_note = ""
 
     def _publish(self, result: CycleResult, t: float, R_command_control: Any = None) -> None:
         """Twist out according to the publish policy; wakes blocking callers when a move ends."""
@@ -322,11 +358,14 @@ class ContactControlNode:
         with self._lock:
             r = self._ctrl.last_result
             note = self._request_note
+            fault = self._fault_note
+            if fault and r.safety == 0 and not fault.startswith("ROS master"):  # the jump is over
+                self._fault_note = fault = ""
         msg = self._status_msg  # reused: the status timer allocates nothing per cycle
         msg.header.stamp = rospy.Time.now()
         msg.move_active = r.move_active
         msg.safety = r.safety
-        msg.message = "; ".join(m for m in (r.message, note) if m)
+        msg.message = "; ".join(m for m in (fault, r.message, note) if m)
         w, v = r.wrench, r.velocity
         f, q = msg.wrench.force, msg.wrench.torque
         f.x, f.y, f.z, q.x, q.y, q.z = w
@@ -358,23 +397,14 @@ def read_settings(param_ns: str = "~") -> ContactControlSettings | None:
     return settings
 
 
-def tune_runtime(period: float) -> None:
-    """Keeps the interpreter from delaying the control threads (call once, after start-up)."""
-    # A thread waiting for the GIL can wait a whole switch interval (5 ms by default) for a busy one: keep it
-    # well below the control period so a message is handled on arrival.
-    sys.setswitchinterval(min(sys.getswitchinterval(), period / 10.0))
-    # Start-up objects never die; a full collection over them stalls a cycle for ~15 ms.
-    gc.collect()
-    gc.freeze()
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of `rosrun contact_control contact_control_node`."""
     rospy.init_node("contact_control_node", argv=list(sys.argv if argv is None else argv))
     settings = read_settings()
     if settings is None:
         return 1
-    ContactControlNode(settings)
+    node = ContactControlNode(settings)
+    MasterWatch(node.on_master_lost, node.on_master_back, params=["~"])
     tune_runtime(1.0 / settings.control_rate)
     rospy.loginfo(
         "contact_control_node: wrench in %s, twist out %s (%s), control frame %s, %d parameters loaded",

@@ -40,6 +40,9 @@ PARAMETERS: dict[str, tuple[str, Any, str, str]] = {
     "wrench_timeout": ("pos", 0.1, "s", "no wrench for longer: output zero (SAFETY_STALE)"),
     "no_data_end_timeout": ("nonneg", 1.0, "s", "stale for longer: the move ends with NO_FT_DATA"),
     "check_stamp_age": ("bool", True, "", "wrenches stamped more than wrench_timeout ago are stale"),
+    "future_stamp_tolerance": (
+        "nonneg", 0.1, "s", "with check_stamp_age: wrenches stamped further ahead are refused like NaN",
+    ),
     "publish_when_idle": ("bool", False, "", "publish zero twists when no move is active"),
     "idle_zero_count": ("nonneg", 10.0, "", "zero twists sent after a move ends, then silence"),
     "publish_synchronously": ("bool", True, "", "send the twist from the wrench callback, no sender thread"),
@@ -123,6 +126,7 @@ class ContactControlSettings:
     wrench_timeout: float = 0.1
     no_data_end_timeout: float = 1.0
     check_stamp_age: bool = True
+    future_stamp_tolerance: float = 0.1
     publish_when_idle: bool = False
     idle_zero_count: float = 10.0
     publish_synchronously: bool = True

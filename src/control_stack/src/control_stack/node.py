@@ -15,7 +15,9 @@ import sys
 from collections.abc import Sequence
 
 import rospy
-from contact_control.node import ContactControlNode, read_settings, tune_runtime
+from compliant_common.master import MasterWatch
+from compliant_common.runtime import tune_runtime
+from contact_control.node import ContactControlNode, read_settings
 from jog_arm.node import start as start_jog_arm
 
 __all__ = ["main"]
@@ -34,13 +36,23 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 1
     twist_topic = rospy.resolve_name(settings.velocity_out_topic)
     same_topic = twist_topic == rospy.resolve_name(jog.settings.cmd_in_topic)
-    ContactControlNode(
+    contact = ContactControlNode(
         settings,
         private_ns=cc_ns,
         twist_sink=jog.accept_velocity,
         frame_source=jog.model_frame_pose,
         own_subscribers=int(same_topic),
     )
+
+    def on_lost(reason: str) -> None:
+        contact.on_master_lost(reason)
+        jog.on_master_lost(reason)
+
+    def on_back() -> None:
+        contact.on_master_back()
+        jog.on_master_back()
+
+    MasterWatch(on_lost, on_back, params=[cc_ns, jog_ns, "robot_description"])
     tune_runtime(min(1.0 / settings.control_rate, jog.settings.pub_period))
     rospy.loginfo(
         "control_stack: contact_control (%s) -> jog_arm (%s) in one process; wrench in %s, joint commands "

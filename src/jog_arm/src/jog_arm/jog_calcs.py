@@ -202,6 +202,9 @@ class JogCalcs:
         # the reference configuration Pinocchio reads.
         self._q_meas = [0.0] * n
         self._have_state = False
+        self._state_time: float | None = None  # receive time of the joint state; None: not tracked
+        self._drop_reason = ""  # why the last command was dropped (shown while there is none)
+        self._suspended = ""  # why commands are refused for now (e.g. the ROS master is lost)
         self._q_cmd = [0.0] * n
         self._q_ref = np.zeros(n)
         self._dq_out = [0.0] * n
@@ -226,8 +229,9 @@ class JogCalcs:
 
     # --- inputs ---------------------------------------------------------------------------------------
 
-    def set_joint_state(self, positions: Sequence[float]) -> None:
-        """Sets the measured joint positions [rad], in `joint_names` order.
+    def set_joint_state(self, positions: Sequence[float], now: float | None = None) -> None:
+        """Sets the measured joint positions [rad], in `joint_names` order, received at `now` [s] (None: its
+        age is not checked).
 
         Raises:
             ValueError: Wrong length or a non-finite value (the previous state is kept).
@@ -235,10 +239,12 @@ class JogCalcs:
         values = [float(v) for v in positions]
         if len(values) != self.nv or not all(math.isfinite(v) for v in values):
             raise ValueError(f"joint state must be {self.nv} finite positions for {list(self.joint_names)}")
-        self._store_measured(values)
+        self._store_measured(values, now)
 
-    def set_joint_state_named(self, names: Sequence[str], positions: Sequence[float]) -> bool:
-        """Sets the measured positions from a JointState-like (names, positions) pair.
+    def set_joint_state_named(
+        self, names: Sequence[str], positions: Sequence[float], now: float | None = None
+    ) -> bool:
+        """Sets the measured positions from a JointState-like (names, positions) pair received at `now` [s].
 
         Extra joints are ignored. Returns False, keeping the previous state, if a controlled joint is
         missing or a value is not finite.
@@ -256,10 +262,11 @@ class JogCalcs:
         values = [float(positions[i]) for i in index]
         if not all(math.isfinite(v) for v in values):
             return False
-        self._store_measured(values)
+        self._store_measured(values, now)
         return True
 
-    def _store_measured(self, values: list[float]) -> None:
+    def _store_measured(self, values: list[float], now: float | None) -> None:
+        self._state_time = now
         if self._identity_order:
             self._q_meas = values
         else:
@@ -310,6 +317,8 @@ class JogCalcs:
         """
         if self._paused:
             return CommandResult(False, "paused: commands are ignored until resume")
+        if self._suspended:
+            return CommandResult(False, f"suspended: {self._suspended}")
         reason = ""
         if len(twist) != 6:
             reason = f"a twist has 6 components, got {len(twist)}"
@@ -345,7 +354,30 @@ class JogCalcs:
                 g * wx + h * wy + i * wz,
             )
         self._cmd_time = now
+        self._drop_reason = ""
         return _ACCEPTED
+
+    def drop_command(self, reason: str) -> None:
+        """Forgets the current command (its source vanished): the arm decelerates to rest at once instead of
+        after `incoming_cmd_timeout`; the next command moves it again."""
+        self._cmd_time = None
+        self._cmd_zero = True
+        self._drop_reason = reason
+
+    def clock_jumped(self, description: str) -> None:
+        """The clock jumped: the command's and the joint state's ages are unknown, so the command is dropped
+        and the arm halts until a joint state received after the jump (then the next command moves it)."""
+        self.drop_command(f"{description}: command dropped")
+        if self._state_time is not None:
+            self._state_time = -math.inf
+
+    def suspend(self, reason: str) -> None:
+        """Decelerates to rest and refuses commands until :meth:`unsuspend` (e.g. the master is lost)."""
+        self._suspended = reason
+        self.drop_command(reason)
+
+    def unsuspend(self) -> None:
+        self._suspended = ""
 
     def pause(self) -> None:
         """Stops (smoothly) and ignores commands until :meth:`resume`."""
@@ -388,12 +420,22 @@ class JogCalcs:
         # What to follow.
         status = StatusCode.NO_WARNING
         message = ""
+        state_time = self._state_time
         if self._paused:
             status, message = StatusCode.PAUSED, "paused"
+        elif self._suspended:
+            status, message = StatusCode.PAUSED, f"suspended: {self._suspended}"
+        elif state_time is not None and now - state_time > settings.joint_state_timeout:
+            status = StatusCode.STALE_JOINT_STATE
+            message = (
+                f"no joint state for {now - state_time:.3f} s (joint_state_timeout): stopping"
+                if state_time > -math.inf
+                else "waiting for a joint state received after the clock jump"
+            )
         elif self._rejected:
             status, message = StatusCode.INVALID_COMMAND, f"command rejected: {self._rejected}"
         elif self._cmd_time is None:
-            status, message = StatusCode.STALE_COMMAND, "no command received yet"
+            status, message = StatusCode.STALE_COMMAND, self._drop_reason or "no command received yet"
         elif now - self._cmd_time > settings.incoming_cmd_timeout:
             status = StatusCode.STALE_COMMAND
             message = f"no command for {now - self._cmd_time:.3f} s (incoming_cmd_timeout)"

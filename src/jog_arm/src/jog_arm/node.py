@@ -8,16 +8,20 @@ frames; frames tf does not have either are refused with a warning.
 
 from __future__ import annotations
 
-import gc
 import math
 import sys
 import threading
+import time
 from collections.abc import Sequence
 from typing import Any
 
 import pinocchio as pin
 import rospy
 import tf2_ros
+from compliant_common.clock import ClockJump
+from compliant_common.master import MasterWatch
+from compliant_common.ros_time import JumpAwareClock, timer
+from compliant_common.runtime import tune_runtime
 from compliant_control_msgs.msg import JogStatus
 from geometry_msgs.msg import TwistStamped
 from sensor_msgs.msg import JointState
@@ -66,6 +70,11 @@ class JogArmNode:
         self._frames_ready: set[str] = set()  # command frames known to be usable (model, or tf looked up)
         self._last_status = StatusCode.NO_JOINT_STATE
         self._last_twist_cycle = -math.inf
+        self._last_fill = -math.inf
+        # A clock that stops (a dead /clock source) is a fault too: commands would never turn stale.
+        self._clock = JumpAwareClock(stop_tolerance=max(0.5, 2.0 * settings.incoming_cmd_timeout))
+        self._from_topic = False  # whether the current command came over the topic (not in-process)
+        self._publishers = 0  # connections of the twist subscriber at the last cycle
         self._cycles = CycleMonitor(settings.pub_period)
         self._next_missed_warning = -math.inf
         names = list(self._jog.joint_names)
@@ -100,7 +109,7 @@ class JogArmNode:
             self._timer: rospy.Timer | None = None
             threading.Thread(target=self._fill_gaps, name="jog_arm_gap_filler", daemon=True).start()
         else:
-            self._timer = rospy.Timer(rospy.Duration(settings.pub_period), self._on_timer)
+            self._timer = timer(settings.pub_period, self._on_timer)
         rospy.loginfo(
             "jog_arm_server: %d joints %s, tip %s, commands on %s (%s) -> %s on %s every %.4f s",
             len(names),
@@ -116,8 +125,9 @@ class JogArmNode:
     # --- callbacks ----------------------------------------------------------------------------------------
 
     def _on_joints(self, msg: JointState) -> None:
+        now = self._now()
         with self._lock:
-            ok = self._jog.set_joint_state_named(msg.name, msg.position)
+            ok = self._jog.set_joint_state_named(msg.name, msg.position, now)
         if not ok and self._joint_set.intersection(msg.name):  # other robots' / grippers' states: ignore
             rospy.logwarn_throttle(
                 _WARN_PERIOD,
@@ -135,15 +145,18 @@ class JogArmNode:
         """A velocity command from the topic."""
         lin, ang = msg.twist.linear, msg.twist.angular
         twist = (lin.x, lin.y, lin.z, ang.x, ang.y, ang.z)
-        self.accept_velocity(twist, msg.header.frame_id, rospy.get_time())
+        self.accept_velocity(twist, msg.header.frame_id, self._now(), from_topic=True)
 
-    def accept_velocity(self, twist: Sequence[float], frame: str, now: float) -> None:
+    def accept_velocity(
+        self, twist: Sequence[float], frame: str, now: float, from_topic: bool = False
+    ) -> None:
         """A velocity command (vx, vy, vz, wx, wy, wz) in `frame` ("": the default) received at `now` [s]:
         from the topic, or from a controller in the same process (no message to fill and read back)."""
         frame = frame.lstrip("/")
         self._ensure_frame(frame or self._s.default_cmd_frame)
         with self._lock:
             result = self._jog.set_command(twist, frame, now)
+            self._from_topic = from_topic
         if not result.accepted:
             rospy.logwarn_throttle(_WARN_PERIOD, f"jog_arm_server: command refused: {result.reason}")
         elif self._s.publish_on_command:
@@ -180,24 +193,36 @@ class JogArmNode:
             self._s.planning_frame,
         )
 
+    def _now(self) -> float:
+        """The ROS time [s]; a jump (or a stopped clock) is handled first: see `_on_clock_jump`."""
+        now, jump = self._clock.read()
+        if jump is not None:
+            self._on_clock_jump(jump)
+        return now
+
+    def _on_clock_jump(self, jump: ClockJump) -> None:
+        note = jump.describe()
+        rospy.logwarn("jog_arm_server: %s: stopping until a fresh joint state and a new command", note)
+        self._last_twist_cycle = self._last_fill = -math.inf  # the gap filler's schedule was in the old time
+        with self._lock:
+            self._jog.clock_jumped(note)
+
     def _on_timer(self, _event: rospy.timer.TimerEvent) -> None:
-        self._cycle(rospy.get_time())
+        self._cycle(self._now())
 
     def _fill_gaps(self) -> None:
         """publish_on_command: sleeps while twists run the cycles; runs one when a twist is missing and one
-        per period once twists stop (see timing.FILL_AFTER)."""
-        period, last_fill = self._s.pub_period, -math.inf
+        per period once twists stop (see timing.FILL_AFTER). It sleeps on the wall clock, so neither a clock
+        jump nor a stopped clock can stall it."""
+        period = self._s.pub_period
         while not (self._closed or rospy.is_shutdown()):
-            now = rospy.get_time()
-            due = next_fill_time(self._last_twist_cycle, last_fill, period)
+            now = self._now()
+            due = next_fill_time(self._last_twist_cycle, self._last_fill, period)
             if now >= due:
-                last_fill = now
+                self._last_fill = now
                 self._cycle(now)
-                due = next_fill_time(self._last_twist_cycle, last_fill, period)
-            try:
-                rospy.sleep(max(due - rospy.get_time(), 1e-4))
-            except rospy.ROSInterruptException:
-                return
+                due = next_fill_time(self._last_twist_cycle, self._last_fill, period)
+            time.sleep(min(max(due - now, 1e-4), period))
 
     def _cycle(self, now: float) -> None:
         """One control cycle: compute, publish the joint command and the status."""
@@ -208,7 +233,12 @@ class JogArmNode:
                 f"jog_arm_server: {self._cycles.missed} publish cycles missed so far "
                 f"(longest gap {self._cycles.max_gap * 1e3:.1f} ms, period {self._s.pub_period * 1e3:g} ms)"
             )
+        publishers = self._subs[1].get_num_connections()
         with self._lock:
+            if publishers < self._publishers and self._from_topic:  # its publisher died or was stopped
+                self._jog.drop_command("the command's publisher disconnected")
+                self._from_topic = False
+            self._publishers = publishers
             out = self._jog.step(now)
             publish = out.publish
             if publish:
@@ -279,6 +309,16 @@ class JogArmNode:
         self._cycles.reset()
         return TriggerResponse(success=True, message=" ".join(f"{k}={v}" for k, v in summary.items()))
 
+    def on_master_lost(self, reason: str) -> None:
+        """The graph is broken: stop, and refuse commands until the master is back."""
+        rospy.logerr("jog_arm_server: %s: stopping the arm until it returns", reason)
+        with self._lock:
+            self._jog.suspend(reason)
+
+    def on_master_back(self) -> None:
+        with self._lock:
+            self._jog.unsuspend()
+
     def model_frame_pose(self, frame: str, relative_to: str) -> list[list[float]] | None:
         """Pose (4x4 rows) of a robot-model frame in another at the last joint state, for a controller in the
         same process (fresher than tf and no /tf to deserialise); None if either is not a model frame.
@@ -341,14 +381,8 @@ def main(argv: list[str] | None = None) -> int:
     node = start()
     if node is None:
         return 1
-    settings = node.settings
-    # A thread waiting for the GIL waits up to the switch interval (5 ms by default) for a busy one (rospy's
-    # receive threads at 1 kHz) to let go: keep it well below the publish period so cycles start on time.
-    sys.setswitchinterval(min(sys.getswitchinterval(), settings.pub_period / 10.0))
-    # Start-up objects (Pinocchio model, rospy machinery) never die: keep them out of the collector's
-    # full passes, which would otherwise stall a cycle for milliseconds now and then.
-    gc.collect()
-    gc.freeze()
+    MasterWatch(node.on_master_lost, node.on_master_back, params=["~", "robot_description"])
+    tune_runtime(node.settings.pub_period)
     rospy.spin()
     return 0
 

@@ -79,6 +79,7 @@ class JogSettings:
     cmd_in_topic: str = "jog_arm_server/delta_jog_cmds"
     cmd_frame: str = ""  # frame of commands whose header has none; "" = planning_frame
     incoming_cmd_timeout: float = 1.0  # [s]
+    joint_state_timeout: float = 0.2  # [s] a joint state older than this halts (STALE_JOINT_STATE)
     cmd_out_topic: str = "arm_controller/command"
     singularity_threshold: float = 7.0  # [-] condition number where slowing starts
     hard_stop_singularity_threshold: float = 12.0  # [-] condition number where motion stops
@@ -186,6 +187,7 @@ class JogSettings:
             "scale_linear",
             "scale_rotational",
             "incoming_cmd_timeout",
+            "joint_state_timeout",
             "pub_period",
             "singularity_threshold",
             "singularity_length_scale",

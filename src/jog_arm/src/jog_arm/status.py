@@ -20,3 +20,4 @@ class StatusCode(IntEnum):
     INVALID_COMMAND = 7
     PAUSED = 8
     NO_JOINT_STATE = 9
+    STALE_JOINT_STATE = 10

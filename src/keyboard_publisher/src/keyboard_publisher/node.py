@@ -8,6 +8,7 @@ import time
 from typing import TextIO
 
 import rospy
+from compliant_common.master import MasterWatch
 from geometry_msgs.msg import TwistStamped
 
 from keyboard_publisher.keymap import Action, key_code, render_help, render_speeds
@@ -135,6 +136,8 @@ def main(argv: list[str] | None = None) -> int:
     for warning in warnings:
         rospy.logwarn(f"key_to_twist: {warning}")
     node = KeyToTwist(settings, sys.stdout)
+    # Twists keep flowing on existing connections while the master is away; a new one learns of us again.
+    MasterWatch(lambda reason: rospy.logwarn(f"key_to_twist: {reason}"), lambda: None, params=["~"])
     fd = stdin.fileno()
     with StopSignals() as signals, RawTerminal(fd):
         code = node.run(KeyReader(fd), signals.event)

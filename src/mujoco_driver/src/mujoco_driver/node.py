@@ -9,7 +9,6 @@ Messages and arrays are allocated once; the loop fills them in place.
 from __future__ import annotations
 
 import faulthandler
-import gc
 import math
 import os
 import signal
@@ -21,6 +20,8 @@ from typing import Any
 import numpy as np
 import rospy
 import rospy.impl.simtime as simtime
+from compliant_common.master import MasterWatch
+from compliant_common.runtime import tune_runtime
 from compliant_control_msgs.srv import PushEEF, PushEEFResponse
 from geometry_msgs.msg import PoseStamped, WrenchStamped
 from rosgraph_msgs.msg import Clock
@@ -421,12 +422,15 @@ def main(argv: list[str] | None = None) -> int:
     if settings.publish_clock and not rospy.get_param("/use_sim_time", False):
         rospy.logwarn("mujoco_driver: publishing /clock but /use_sim_time is false: other nodes use the wall "
                       "clock and see stamps in simulated time")
-    # Start-up objects (MuJoCo model, rospy machinery) live for good: keep them out of the collector's full
-    # passes, which would stall a step for milliseconds now and then. A thread waiting for the GIL waits up
-    # to the switch interval (5 ms by default) for a busy one: keep it well below the timestep.
-    gc.freeze()
+    # A new master (roscore restarted) gets this node's topics, services and parameters again.
+    MasterWatch(
+        lambda reason: rospy.logerr("mujoco_driver: %s; the arm stops when commands stop (command_timeout)",
+                                    reason),
+        lambda: None,
+        params=["~", "robot_description", "/use_sim_time"],
+    )
     faulthandler.register(signal.SIGUSR1, all_threads=True)  # `kill -USR1 <pid>`: every thread's stack
-    sys.setswitchinterval(min(sys.getswitchinterval(), node.dt / 4.0))
+    tune_runtime(node.dt, switch_fraction=0.25)
     if not stop_early:
         node.run()
     rospy.signal_shutdown("stopped")

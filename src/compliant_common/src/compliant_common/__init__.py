@@ -1,0 +1,1 @@
+"""Runtime helpers shared by the stack's nodes (see the package README)."""
