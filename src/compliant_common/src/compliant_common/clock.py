@@ -81,7 +81,7 @@ class ClockWatch:
         if monotonic < last_mono:
             return None
         self._last, self._last_mono = now, monotonic
-        if last != last:  # first observation (NaN)
+        if last != last or last == 0.0:  # first observation (NaN), or sim time before the first /clock
             self._advanced = monotonic
             return None
         step = now - last

@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextlib
 import sys
 import threading
+import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -46,6 +47,7 @@ from contact_control.request import RequestError, RequestLimits, validate_reques
 __all__ = ["ContactControlNode", "main", "read_settings"]
 
 _ZERO = (0.0,) * 6
+FAULT_SHOWN_FOR = 1.0  # [s] a clock jump stays on ~status at least this long, so a 50 Hz reader sees it
 _TF_ERRORS = (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException)
 # (frame, relative_to) -> 4x4 rows, None if unknown; raises LookupError while it cannot answer yet.
 FrameSource = Callable[[str, str], "list[list[float]] | None"]
@@ -99,6 +101,7 @@ class ContactControlNode:
         self._was_active = False
         self._request_note = ""
         self._fault_note = ""  # a clock jump or a lost master, for ~status until it is over
+        self._fault_shown_until = 0.0  # [s, monotonic] a past fault stays on ~status at least this long
         self._clock = JumpAwareClock()
         self._twist_sink = twist_sink
         self._own_subscribers = own_subscribers
@@ -243,6 +246,7 @@ class ContactControlNode:
         rospy.logwarn("contact_control: %s: holding (zero twist) until fresh data", note)
         with self._lock:
             self._fault_note = note
+            self._fault_shown_until = time.monotonic() + FAULT_SHOWN_FOR
             self._publish(self._ctrl.clock_jumped(t, note), t)
 
     # --- master ---
@@ -359,7 +363,8 @@ class ContactControlNode:
             r = self._ctrl.last_result
             note = self._request_note
             fault = self._fault_note
-            if fault and r.safety == 0 and not fault.startswith("ROS master"):  # the jump is over
+            over = r.safety == 0 and time.monotonic() > self._fault_shown_until
+            if fault and over and not fault.startswith("ROS master"):  # the jump is over
                 self._fault_note = fault = ""
         msg = self._status_msg  # reused: the status timer allocates nothing per cycle
         msg.header.stamp = rospy.Time.now()

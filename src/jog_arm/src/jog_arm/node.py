@@ -39,6 +39,7 @@ __all__ = ["JogArmNode", "main", "start"]
 
 _TF_ERRORS = (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException)
 _WARN_PERIOD = 2.0  # [s] throttle of repeated warnings
+NOTE_SHOWN_FOR = 1.0  # [s] a clock jump stays on ~status at least this long
 
 
 class JogArmNode:
@@ -75,6 +76,8 @@ class JogArmNode:
         self._clock = JumpAwareClock(stop_tolerance=max(0.5, 2.0 * settings.incoming_cmd_timeout))
         self._from_topic = False  # whether the current command came over the topic (not in-process)
         self._publishers = 0  # connections of the twist subscriber at the last cycle
+        self._fault_note = ""  # a clock jump, shown on ~status for NOTE_SHOWN_FOR s
+        self._fault_shown_until = 0.0
         self._cycles = CycleMonitor(settings.pub_period)
         self._next_missed_warning = -math.inf
         names = list(self._jog.joint_names)
@@ -204,6 +207,7 @@ class JogArmNode:
         note = jump.describe()
         rospy.logwarn("jog_arm_server: %s: stopping until a fresh joint state and a new command", note)
         self._last_twist_cycle = self._last_fill = -math.inf  # the gap filler's schedule was in the old time
+        self._fault_note, self._fault_shown_until = note, time.monotonic() + NOTE_SHOWN_FOR
         with self._lock:
             self._jog.clock_jumped(note)
 
@@ -253,6 +257,11 @@ class JogArmNode:
         if self._status_pub.get_num_connections() > 0:  # nobody listening: save the cycle the work
             msg = self._status_msg
             msg.header.stamp = rospy.Time.from_sec(now)
+            if self._fault_note:
+                if time.monotonic() < self._fault_shown_until:
+                    message = f"{self._fault_note}; {message}"
+                else:
+                    self._fault_note = ""
             msg.code, msg.message, msg.condition_number, msg.speed_scale = (
                 int(status),
                 message,
