@@ -10,7 +10,7 @@ import xmlrpc.client
 
 from harness.process import stop_process_group
 
-__all__ = ["Master", "free_port", "start_master"]
+__all__ = ["Master", "free_port", "restart_master", "start_master"]
 
 DEFAULT_PORT = 11311
 
@@ -54,13 +54,14 @@ def master_env(port: int, base: dict[str, str] | None = None) -> dict[str, str]:
     return env
 
 
-def start_master(timeout: float = 30.0, log_dir: str | None = None) -> Master:
-    """Starts `roscore -p PORT` in its own process group and waits until it answers.
+def start_master(timeout: float = 30.0, log_dir: str | None = None, port: int | None = None) -> Master:
+    """Starts `roscore -p PORT` (a free port unless given) in its own process group and waits until it
+    answers.
 
     Raises:
         RuntimeError: roscore exited or did not answer within `timeout`.
     """
-    port = free_port()
+    port = free_port() if port is None else port
     env = master_env(port)
     if log_dir:
         env["ROS_LOG_DIR"] = log_dir
@@ -81,6 +82,18 @@ def start_master(timeout: float = 30.0, log_dir: str | None = None) -> Master:
         time.sleep(0.05)
     master.stop()
     raise RuntimeError(f"roscore on port {port} did not come up within {timeout} s")
+
+
+def restart_master(master: Master, down_for: float = 0.0, timeout: float = 30.0) -> float:
+    """Stops `master` (as a crash or Ctrl-C would), waits `down_for` s and starts a new, empty roscore on the
+    same port; `master` then refers to the new one. Returns the monotonic time the old one was stopped.
+    """
+    master.stop()
+    stopped = time.monotonic()
+    time.sleep(down_for)  # the outage itself is what a restart test simulates
+    new = start_master(timeout, master.env.get("ROS_LOG_DIR"), master.port)
+    master.proc = new.proc
+    return stopped
 
 
 def _rosout_up(master: Master) -> bool:

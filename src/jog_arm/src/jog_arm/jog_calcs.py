@@ -377,6 +377,9 @@ class JogCalcs:
         self.drop_command(reason)
 
     def unsuspend(self) -> None:
+        """Accepts commands again; the arm stays at rest until the next one."""
+        if self._suspended and self._drop_reason == self._suspended:
+            self._drop_reason = ""
         self._suspended = ""
 
     def pause(self) -> None:
