@@ -16,20 +16,25 @@ MuJoCo's force/torque sensors report the interaction between the sensor body's s
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
 
 from mujoco_driver.config import SceneConfig
+from mujoco_driver.meshes import LinkGeometry, prepare_collision
 
 __all__ = [
-    "SceneError", "SceneModel", "UrdfJoint", "build_scene", "mujoco_urdf", "rpy_to_quat", "urdf_joints"
+    "SceneError", "SceneModel", "UrdfJoint", "build_scene", "mujoco_urdf", "mujoco_urdf_report",
+    "rpy_to_quat", "urdf_joints",
 ]
+
+_log = logging.getLogger(__name__)
 
 _INPUT = mujoco.mjtCtrlInput
 PID_INPUTS = int(_INPUT.mjINPUT_POS | _INPUT.mjINPUT_VEL | _INPUT.mjINPUT_FF)  # ctrl: [pos, vel, ff]
@@ -102,16 +107,28 @@ def urdf_joints(urdf_xml: str) -> dict[str, UrdfJoint]:
     return joints
 
 
-def mujoco_urdf(urdf_xml: str) -> str:
+def mujoco_urdf(urdf_xml: str, mesh_cache: str | None = None) -> str:
     """The URDF as MuJoCo should read it: collision only, plain mesh paths, every link a body.
+
+    Meshes MuJoCo cannot read are converted or replaced (see :func:`mujoco_urdf_report`).
+
+    Raises:
+        SceneError: On malformed XML or a mesh that is not a local file.
+    """
+    return mujoco_urdf_report(urdf_xml, mesh_cache)[0]
+
+
+def mujoco_urdf_report(urdf_xml: str, mesh_cache: str | None = None) -> tuple[str, list[LinkGeometry]]:
+    """:func:`mujoco_urdf` and what became of each link's collision geometry.
+
+    Collision meshes MuJoCo cannot read (COLLADA, ...) are converted to STL in `mesh_cache`
+    (default :func:`mujoco_driver.meshes.default_cache_dir`) or replaced by fitted primitives; a link
+    without collision geometry takes its visual one, or a capsule to its child joints if it has mass.
 
     Raises:
         SceneError: On malformed XML or a mesh that is not a local file.
     """
     robot = _parse(urdf_xml)
-    for link in robot.findall("link"):
-        for visual in link.findall("visual"):
-            link.remove(visual)
     for mesh in robot.iter("mesh"):
         uri = mesh.get("filename", "")
         path = uri[len("file://"):] if uri.startswith("file://") else uri
@@ -120,12 +137,16 @@ def mujoco_urdf(urdf_xml: str) -> str:
         if not os.path.isfile(path):
             raise SceneError(f"collision mesh {path} does not exist")
         mesh.set("filename", path)
+    report = prepare_collision(robot, mesh_cache)
+    for link in robot.findall("link"):
+        for visual in link.findall("visual"):
+            link.remove(visual)
     for old in robot.findall("mujoco"):
         robot.remove(old)
     extension = ET.SubElement(robot, "mujoco")
     ET.SubElement(extension, "compiler", fusestatic="false", discardvisual="true", strippath="false",
                   balanceinertia="true")
-    return ET.tostring(robot, encoding="unicode")
+    return ET.tostring(robot, encoding="unicode"), report
 
 
 @dataclass
@@ -150,6 +171,7 @@ class SceneModel:
         tool_body: Body id of the tool link (pushes are applied at its centre of mass).
         eef_body: Body id of the end-effector frame link.
         payload_mass: Mass below the sensor [kg].
+        geometry: What became of each link's collision geometry (kept, converted, fitted primitive, none).
     """
 
     model: mujoco.MjModel
@@ -169,6 +191,7 @@ class SceneModel:
     tool_body: int
     eef_body: int
     payload_mass: float
+    geometry: list[LinkGeometry] = field(default_factory=list)
 
 
 def _subtree(root: mujoco.MjsBody) -> list[mujoco.MjsBody]:
@@ -194,12 +217,17 @@ def _add_environment(spec: mujoco.MjSpec, cfg: SceneConfig) -> None:
                        pos=list(obs.position), quat=rpy_to_quat(obs.rpy), rgba=[0.8, 0.2, 0.2, 1.0])
 
 
-def build_scene(urdf_xml: str, cfg: SceneConfig) -> SceneModel:
+def build_scene(urdf_xml: str, cfg: SceneConfig, mesh_cache: str | None = None) -> SceneModel:
     """Compile the scene.
+
+    Continuous URDF joints become unlimited hinges (MuJoCo's URDF reader does that; their range is
+    -inf..inf here). Links whose geometry had to be converted or replaced are logged (INFO) and listed
+    in :attr:`SceneModel.geometry`.
 
     Args:
         urdf_xml: The robot description (meshes as absolute paths or ``file://`` URIs).
         cfg: The validated scene settings.
+        mesh_cache: Directory of converted meshes; None = :func:`mujoco_driver.meshes.default_cache_dir`.
 
     Returns:
         The compiled model with its indices.
@@ -209,8 +237,12 @@ def build_scene(urdf_xml: str, cfg: SceneConfig) -> SceneModel:
             slide, or a per-joint setting does not match the URDF's joints.
     """
     limits = urdf_joints(urdf_xml)
+    mjcf_urdf, geometry = mujoco_urdf_report(urdf_xml, mesh_cache)
+    for entry in geometry:
+        if entry.changed:
+            _log.info("%s", entry)
     try:
-        spec = mujoco.MjSpec.from_string(mujoco_urdf(urdf_xml))
+        spec = mujoco.MjSpec.from_string(mjcf_urdf)
     except ValueError as exc:
         raise SceneError(f"MuJoCo cannot read the URDF: {exc}") from exc
     spec.option.timestep = cfg.timestep
@@ -289,4 +321,5 @@ def build_scene(urdf_xml: str, cfg: SceneConfig) -> SceneModel:
         tool_body=model.body(cfg.links.tool).id,
         eef_body=model.body(cfg.links.eef).id,
         payload_mass=float(model.body_subtreemass[sensor_id]),
+        geometry=geometry,
     )
