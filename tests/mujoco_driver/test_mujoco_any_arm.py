@@ -221,6 +221,14 @@ def test_a_link_without_collision_takes_its_visual_mesh(tmp_path: pathlib.Path, 
     np.testing.assert_allclose(verts.max(axis=0), CUBE_CENTRE + CUBE_HALF, atol=1e-6)
 
 
+def test_unresolved_visual_meshes_are_ignored(cache: str) -> None:
+    visual = '<visual><geometry><mesh filename="package://elsewhere/meshes/link2.dae"/></geometry></visual>'
+    urdf = arm_urdf({"link2": "VISUAL"}).replace("VISUAL", visual)  # make_description would refuse it
+    sim = Simulation(urdf, SCENE, mesh_cache=cache)
+    entry = next(e for e in sim.scene.geometry if e.link == "link2")
+    assert entry.action == "capsule from child joints"
+
+
 def test_converted_meshes_are_reused_from_the_cache(tmp_path: pathlib.Path, cache: str) -> None:
     dae = write_cube_dae(tmp_path / "cube.dae")
     urdf = arm_urdf({"link2": mesh_collision(dae)})

@@ -2,7 +2,9 @@
 
 The scene, all in the robot's base frame (the URDF root link, which is also MuJoCo's world frame):
   * the robot from the URDF: collision geometry only (visual meshes are dropped), every link a body
-    (``fusestatic`` off) so the F/T sensor frame and the tool exist as bodies;
+    (``fusestatic`` off) so the F/T sensor frame and the tool exist as bodies; meshes MuJoCo cannot read
+    are converted or replaced by fitted primitives (``mujoco_driver.meshes``), continuous joints are
+    unlimited hinges;
   * a table whose top is the z = 0 plane (the robot stands on it), a floor, an optional box obstacle;
   * a site at the F/T sensor frame carrying a MuJoCo ``force`` and ``torque`` sensor;
   * one PID joint servo per joint with inputs [position, velocity, feed-forward torque] (its I gain is
@@ -129,14 +131,25 @@ def mujoco_urdf_report(urdf_xml: str, mesh_cache: str | None = None) -> tuple[st
         SceneError: On malformed XML or a mesh that is not a local file.
     """
     robot = _parse(urdf_xml)
-    for mesh in robot.iter("mesh"):
-        uri = mesh.get("filename", "")
-        path = uri[len("file://"):] if uri.startswith("file://") else uri
-        if "://" in path or not os.path.isabs(path):
-            raise SceneError(f"collision mesh {uri!r} is not an absolute path; resolve it (make_description)")
-        if not os.path.isfile(path):
-            raise SceneError(f"collision mesh {path} does not exist")
-        mesh.set("filename", path)
+    for link in robot.findall("link"):
+        # Visual meshes only matter as stand-ins for a missing collision: unusable ones go, unchecked.
+        for visual in link.findall("visual"):
+            for mesh in visual.iter("mesh"):
+                path = _local_path(mesh.get("filename", ""))
+                if path is None or not os.path.isfile(path):
+                    link.remove(visual)
+                    break
+                mesh.set("filename", path)
+        for mesh in (m for collision in link.findall("collision") for m in collision.iter("mesh")):
+            uri = mesh.get("filename", "")
+            path = _local_path(uri)
+            if path is None:
+                raise SceneError(
+                    f"collision mesh {uri!r} is not an absolute path; resolve it (make_description)"
+                )
+            if not os.path.isfile(path):
+                raise SceneError(f"collision mesh {path} does not exist")
+            mesh.set("filename", path)
     report = prepare_collision(robot, mesh_cache)
     for link in robot.findall("link"):
         for visual in link.findall("visual"):
@@ -147,6 +160,12 @@ def mujoco_urdf_report(urdf_xml: str, mesh_cache: str | None = None) -> tuple[st
     ET.SubElement(extension, "compiler", fusestatic="false", discardvisual="true", strippath="false",
                   balanceinertia="true")
     return ET.tostring(robot, encoding="unicode"), report
+
+
+def _local_path(uri: str) -> str | None:
+    """The absolute file path of a mesh URI (plain or ``file://``), None for anything else."""
+    path = uri[len("file://"):] if uri.startswith("file://") else uri
+    return path if "://" not in path and os.path.isabs(path) else None
 
 
 @dataclass
