@@ -169,6 +169,12 @@ class JogCalcs:
             settings.joint_limit_slowdown_width,
             settings.pub_period,
         )
+        # Continuous joints without position limits: whole turns apart is the same posture for them.
+        self._turning = [
+            i
+            for i, continuous in enumerate(self.model.continuous)
+            if continuous and math.isinf(self.model.lower[i]) and math.isinf(self.model.upper[i])
+        ]
         self._filter = LowPassFilter(settings.low_pass_filter_coeff, n)
         self._from_commanded = settings.integrate_from == "commanded"
         self._posture_fixed = bool(settings.nullspace_posture)
@@ -553,9 +559,18 @@ class JogCalcs:
             q_ref = self._q_cmd
             limit = self.settings.max_tracking_error
             if limit > 0.0 and max(map(abs, map(operator.sub, q_meas, q_ref))) > limit:
-                return q_meas, True
+                # A driver may wrap a continuous joint's angle while the command goes on unwrapped.
+                if not self._turning or self._wrapped_error(q_meas, q_ref) > limit:
+                    return q_meas, True
             return q_ref, False
         return q_meas, False
+
+    def _wrapped_error(self, q_meas: list[float], q_ref: list[float]) -> float:
+        """Largest |measured - reference|, whole turns of the continuous joints taken out."""
+        error = [abs(m - r) for m, r in zip(q_meas, q_ref, strict=True)]
+        for i in self._turning:
+            error[i] = abs(math.remainder(q_meas[i] - q_ref[i], math.tau))
+        return max(error)
 
     def _geometry(self, q_ref: list[float]) -> _Geometry:
         """The twist-independent part of a cycle at `q_ref`, reused while `q_ref` does not change.

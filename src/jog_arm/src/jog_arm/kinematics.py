@@ -6,10 +6,18 @@ and its data are built once; every query reuses them.
 
 Frames: Jacobians are ``LOCAL_WORLD_ALIGNED`` at the tip frame, i.e. the velocity of the tip's origin and
 the angular velocity, both with the axes of the model's root (``universe``) frame.
+
+Continuous joints: Pinocchio models an unbounded revolute joint with two configuration values (cos, sin)
+and one velocity, so its ``q`` is longer than ``v``. Every array this class takes or returns has ONE value
+per controlled joint (the angle, as ``sensor_msgs/JointState`` carries it); :meth:`ArmModel.pin_q` turns
+such an array into Pinocchio's ``q`` in a preallocated buffer. Angles of continuous joints are taken as
+they come (unwrapped: 7.0 rad is fine), have no position limits (-inf, +inf) unless the configuration
+sets some, and keep their velocity and acceleration limits.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -31,12 +39,18 @@ class ArmModel:
         urdf_xml: The URDF as a string (the `robot_description` parameter).
         tip_frame: Frame whose motion is commanded (a link or fixed-joint frame of the URDF).
         joint_names: Controlled joints in the order the caller uses; empty = every joint from the root to
-            `tip_frame`. The model's own order is the kinematic order; arrays in this class use it.
+            `tip_frame`. The model's own order is the kinematic order; arrays in this class use it, one
+            value per joint (continuous joints included: see the module docstring).
         joint_limits: Per-joint overrides of the URDF limits.
         default_max_acceleration: Acceleration limit [rad/s²] of joints without an override.
 
     Raises:
-        KinematicsError: Unparsable URDF, unknown frame or joint, or a joint that is not a 1-DoF joint.
+        KinematicsError: Unparsable URDF, unknown frame or joint, a joint that is not a 1-DoF joint, or
+            a joint without a velocity limit (continuous joints often lack one: set it in the YAML).
+
+    Attributes:
+        continuous: Per joint (model order), True for a continuous joint. Its `lower` / `upper` are
+            -inf / +inf unless overridden.
     """
 
     def __init__(
@@ -60,9 +74,10 @@ class ArmModel:
             if not full.existJointName(name):
                 raise KinematicsError(f"joint_names: {name!r} is not a joint of the URDF")
             joint = full.joints[full.getJointId(name)]
-            if joint.nq != 1 or joint.nv != 1:
+            if joint.nv != 1 or joint.nq not in (1, 2):
                 raise KinematicsError(
-                    f"joint_names: {name!r} is not a 1-DoF revolute or prismatic joint (nq={joint.nq})"
+                    f"joint_names: {name!r} is not a 1-DoF revolute, continuous or prismatic joint "
+                    f"(nq={joint.nq}, nv={joint.nv})"
                 )
         locked = [jid for jid in range(1, full.njoints) if full.names[jid] not in controlled]
         model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
@@ -77,8 +92,21 @@ class ArmModel:
         self.tip_id = model.getFrameId(tip_frame)
         self._tip_support = set(model.supports[model.frames[self.tip_id].parentJoint])
 
-        lower = model.lowerPositionLimit.copy()
-        upper = model.upperPositionLimit.copy()
+        # (q index, v index) of the 1-value joints and of the (cos, sin) continuous ones, model order.
+        joints = [model.joints[jid] for jid in range(1, model.njoints)]
+        self.continuous: tuple[bool, ...] = tuple(joint.nq == 2 for joint in joints)
+        self._plain = not any(self.continuous)  # q is the angle array itself
+        self._single = [(j.idx_q, j.idx_v) for j in joints if j.nq == 1]
+        self._unbounded = [(j.idx_q, j.idx_v) for j in joints if j.nq == 2]
+        self._q_pin = pin.neutral(model)  # conversion buffers: one per caller kind, never shared
+        self._q_pin_pose = pin.neutral(model)
+        self._q_pin_query = pin.neutral(model)
+        lower = np.array([
+            -math.inf if j.nq == 2 else model.lowerPositionLimit[j.idx_q] for j in joints
+        ])
+        upper = np.array([
+            math.inf if j.nq == 2 else model.upperPositionLimit[j.idx_q] for j in joints
+        ])
         velocity = model.velocityLimit.copy()
         acceleration = np.full(self.nv, float(default_max_acceleration))
         overrides = dict(joint_limits or {})
@@ -115,8 +143,40 @@ class ArmModel:
     # --- queries -------------------------------------------------------------------------------------
 
     def neutral(self) -> np.ndarray:
-        """Neutral (all zero) configuration of the controlled joints, a fresh array."""
-        return pin.neutral(self.model)
+        """Neutral (all zero) configuration of the controlled joints, one angle each, a fresh array."""
+        return np.zeros(self.nv)
+
+    def pin_q(self, q: Sequence[float], out: np.ndarray | None = None) -> np.ndarray:
+        """Pinocchio configuration for the joint values `q` (one per joint, model order).
+
+        Args:
+            q: Joint angles [rad] or positions [m]; continuous joints as any (unwrapped) angle.
+            out: Buffer of length ``model.nq`` to fill; None = a buffer of this model, overwritten by the
+                next call (fine for the immediate Pinocchio call it feeds).
+
+        Returns:
+            `q` itself (as an array) when no joint is continuous, else `out` with (cos, sin) per continuous
+            joint.
+        """
+        if self._plain:
+            return q if isinstance(q, np.ndarray) else np.asarray(q, dtype=float)
+        buf = self._q_pin_query if out is None else out
+        for iq, iv in self._single:
+            buf[iq] = q[iv]
+        for iq, iv in self._unbounded:
+            angle = q[iv]
+            buf[iq] = math.cos(angle)
+            buf[iq + 1] = math.sin(angle)
+        return buf
+
+    def angles(self, q_pin: np.ndarray) -> np.ndarray:
+        """Joint values (one per joint, angles in (-pi, pi] for continuous joints) of a Pinocchio `q_pin`."""
+        values = np.empty(self.nv)
+        for iq, iv in self._single:
+            values[iv] = q_pin[iq]
+        for iq, iv in self._unbounded:
+            values[iv] = math.atan2(q_pin[iq + 1], q_pin[iq])
+        return values
 
     def has_frame(self, name: str) -> bool:
         """True if `name` is a frame (link or joint) of the model."""
@@ -141,7 +201,8 @@ class ArmModel:
 
         Also refreshes the placements of the joints on the tip's chain and of the tip frame in `self.data`.
         """
-        return pin.computeFrameJacobian(self.model, self.data, q, self.tip_id, pin.LOCAL_WORLD_ALIGNED)
+        q_pin = self.pin_q(q, self._q_pin)
+        return pin.computeFrameJacobian(self.model, self.data, q_pin, self.tip_id, pin.LOCAL_WORLD_ALIGNED)
 
     def frame_rotation(self, frame_id: int, q: np.ndarray | None = None) -> np.ndarray:
         """Rotation of a frame in the root frame, after :meth:`jacobian` (or at `q` if given).
@@ -149,7 +210,7 @@ class ArmModel:
         Frames off the tip's chain need `q` (a full forward kinematics), unless fixed to the root.
         """
         if q is not None:
-            pin.forwardKinematics(self.model, self.data, q)
+            pin.forwardKinematics(self.model, self.data, self.pin_q(q, self._q_pin))
         return pin.updateFramePlacement(self.model, self.data, frame_id).rotation
 
     def frame_pose(self, q: np.ndarray, frame: str, relative_to: str = "") -> pin.SE3:
@@ -159,7 +220,7 @@ class ArmModel:
             KinematicsError: Unknown frame.
         """
         fid = self.frame_id(frame)
-        pin.forwardKinematics(self.model, self.data, q)
+        pin.forwardKinematics(self.model, self.data, self.pin_q(q, self._q_pin))
         pose = pin.updateFramePlacement(self.model, self.data, fid).copy()
         if relative_to:
             base = pin.updateFramePlacement(self.model, self.data, self.frame_id(relative_to))
@@ -174,7 +235,7 @@ class ArmModel:
         """
         data = self._pose_data
         if q is not self._pose_q:
-            pin.forwardKinematics(self.model, data, np.asarray(q, dtype=float))
+            pin.forwardKinematics(self.model, data, self.pin_q(np.asarray(q, dtype=float), self._q_pin_pose))
             self._pose_q = q
         pose = pin.updateFramePlacement(self.model, data, frame_id)
         if base_id != 0:  # frame 0 is the root ("universe")

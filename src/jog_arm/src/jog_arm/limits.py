@@ -44,9 +44,12 @@ def singularity_scale(condition: float, threshold: float, hard_stop: float, towa
 class JointLimiter:
     """Joint position, velocity and acceleration limits of one arm.
 
+    A joint without position limits (a continuous joint: lower -inf and upper +inf) is skipped by the
+    position checks; its velocity and acceleration limits apply as for any joint.
+
     Args:
-        lower: Lower position limits [rad].
-        upper: Upper position limits [rad].
+        lower: Lower position limits [rad] (-inf: none).
+        upper: Upper position limits [rad] (+inf: none).
         max_velocity: Velocity limits [rad/s].
         max_acceleration: Acceleration limits [rad/s²].
         margin: Distance [rad] kept from each position limit.
@@ -81,6 +84,14 @@ class JointLimiter:
             else [math.inf] * len(self._lo)
         )
         self._inv_period = 1.0 / self.period
+        # Position checks loop over the joints with at least one finite stop only, with their constants.
+        self._bounded = [
+            (i, lo, hi, step, two_a, ramp)
+            for i, (lo, hi, step, two_a, ramp) in enumerate(
+                zip(self._lo, self._hi, self._step, self._two_a, self._ramp, strict=True)
+            )
+            if math.isfinite(lo) or math.isfinite(hi)
+        ]
 
     def position_scale(self, q: Sequence[float], dq: Sequence[float]) -> float:
         """Scale for `dq` so no joint runs into its position limit (minus the margin).
@@ -90,7 +101,7 @@ class JointLimiter:
         stop, and the distance it covers in one period. The braking curve ``v²/2a + v·dt <= d`` bounds the
         distance of a stop in steps of ``a·dt`` per cycle (the continuous ``v²/2a`` falls short by up to
         ``v·dt/2 + a·dt²/8``, enough to overrun the margin).
-        Joints moving away from a stop, or still, are never limited.
+        Joints moving away from a stop, or still, and joints without stops are never limited.
 
         Args:
             q: Joint positions the motion starts from [rad].
@@ -100,9 +111,9 @@ class JointLimiter:
             Scale in [0, 1]; 0 if a joint moving toward its stop is already at it.
         """
         scale = 1.0
-        for qi, vi, lo, hi, step, two_a, ramp in zip(
-            q, dq, self._lo, self._hi, self._step, self._two_a, self._ramp, strict=True
-        ):
+        for i, lo, hi, step, two_a, ramp in self._bounded:
+            vi = dq[i]
+            qi = q[i]
             if vi > 0.0:
                 d = hi - qi
             elif vi < 0.0:
@@ -149,7 +160,9 @@ class JointLimiter:
         """Scale for `dq` so ``q + dq·period`` crosses no stop a joint moves toward (the last guard)."""
         scale = 1.0
         period = self.period
-        for qi, vi, lo, hi in zip(q, dq, self._lo, self._hi, strict=True):
+        for i, lo, hi, _, _, _ in self._bounded:
+            vi = dq[i]
+            qi = q[i]
             if vi > 0.0:
                 room = max(hi - qi, 0.0)
                 if vi * period * scale > room:
@@ -161,5 +174,5 @@ class JointLimiter:
         return scale
 
     def within_stops(self, q: Sequence[float]) -> bool:
-        """True if every joint is inside its limits minus the margin."""
-        return all(lo <= qi <= hi for qi, lo, hi in zip(q, self._lo, self._hi, strict=True))
+        """True if every joint is inside its limits minus the margin (joints without stops always are)."""
+        return all(lo <= q[i] <= hi for i, lo, hi, _, _, _ in self._bounded)

@@ -61,6 +61,9 @@ class MujocoDriverNode:
     def __init__(self, settings: DriverSettings, urdf: str, scene_cfg: SceneConfig) -> None:
         self._s = s = settings
         self._sim = sim = Simulation(urdf, scene_cfg)
+        for entry in sim.scene.geometry:  # meshes converted or replaced for MuJoCo: say so, per link
+            if entry.changed:
+                rospy.loginfo("mujoco_driver: collision geometry of %s", entry)
         self._lock = threading.Lock()
         self._base_frame = s.base_frame or urdf_root_link(urdf)
         self._clock_offset = 0.0  # simulated time before the last ~reset, so /clock never runs backwards

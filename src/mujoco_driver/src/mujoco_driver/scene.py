@@ -2,7 +2,9 @@
 
 The scene, all in the robot's base frame (the URDF root link, which is also MuJoCo's world frame):
   * the robot from the URDF: collision geometry only (visual meshes are dropped), every link a body
-    (``fusestatic`` off) so the F/T sensor frame and the tool exist as bodies;
+    (``fusestatic`` off) so the F/T sensor frame and the tool exist as bodies; meshes MuJoCo cannot read
+    are converted or replaced by fitted primitives (``mujoco_driver.meshes``), continuous joints are
+    unlimited hinges;
   * a table whose top is the z = 0 plane (the robot stands on it), a floor, an optional box obstacle;
   * a site at the F/T sensor frame carrying a MuJoCo ``force`` and ``torque`` sensor;
   * one PID joint servo per joint with inputs [position, velocity, feed-forward torque] (its I gain is
@@ -16,20 +18,25 @@ MuJoCo's force/torque sensors report the interaction between the sensor body's s
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
 
 from mujoco_driver.config import SceneConfig
+from mujoco_driver.meshes import LinkGeometry, prepare_collision
 
 __all__ = [
-    "SceneError", "SceneModel", "UrdfJoint", "build_scene", "mujoco_urdf", "rpy_to_quat", "urdf_joints"
+    "SceneError", "SceneModel", "UrdfJoint", "build_scene", "mujoco_urdf", "mujoco_urdf_report",
+    "rpy_to_quat", "urdf_joints",
 ]
+
+_log = logging.getLogger(__name__)
 
 _INPUT = mujoco.mjtCtrlInput
 PID_INPUTS = int(_INPUT.mjINPUT_POS | _INPUT.mjINPUT_VEL | _INPUT.mjINPUT_FF)  # ctrl: [pos, vel, ff]
@@ -102,30 +109,63 @@ def urdf_joints(urdf_xml: str) -> dict[str, UrdfJoint]:
     return joints
 
 
-def mujoco_urdf(urdf_xml: str) -> str:
+def mujoco_urdf(urdf_xml: str, mesh_cache: str | None = None) -> str:
     """The URDF as MuJoCo should read it: collision only, plain mesh paths, every link a body.
+
+    Meshes MuJoCo cannot read are converted or replaced (see :func:`mujoco_urdf_report`).
+
+    Raises:
+        SceneError: On malformed XML or a mesh that is not a local file.
+    """
+    return mujoco_urdf_report(urdf_xml, mesh_cache)[0]
+
+
+def mujoco_urdf_report(urdf_xml: str, mesh_cache: str | None = None) -> tuple[str, list[LinkGeometry]]:
+    """:func:`mujoco_urdf` and what became of each link's collision geometry.
+
+    Collision meshes MuJoCo cannot read (COLLADA, ...) are converted to STL in `mesh_cache`
+    (default :func:`mujoco_driver.meshes.default_cache_dir`) or replaced by fitted primitives; a link
+    without collision geometry takes its visual one, or a capsule to its child joints if it has mass.
 
     Raises:
         SceneError: On malformed XML or a mesh that is not a local file.
     """
     robot = _parse(urdf_xml)
     for link in robot.findall("link"):
+        # Visual meshes only matter as stand-ins for a missing collision: unusable ones go, unchecked.
+        for visual in link.findall("visual"):
+            for mesh in visual.iter("mesh"):
+                path = _local_path(mesh.get("filename", ""))
+                if path is None or not os.path.isfile(path):
+                    link.remove(visual)
+                    break
+                mesh.set("filename", path)
+        for mesh in (m for collision in link.findall("collision") for m in collision.iter("mesh")):
+            uri = mesh.get("filename", "")
+            path = _local_path(uri)
+            if path is None:
+                raise SceneError(
+                    f"collision mesh {uri!r} is not an absolute path; resolve it (make_description)"
+                )
+            if not os.path.isfile(path):
+                raise SceneError(f"collision mesh {path} does not exist")
+            mesh.set("filename", path)
+    report = prepare_collision(robot, mesh_cache)
+    for link in robot.findall("link"):
         for visual in link.findall("visual"):
             link.remove(visual)
-    for mesh in robot.iter("mesh"):
-        uri = mesh.get("filename", "")
-        path = uri[len("file://"):] if uri.startswith("file://") else uri
-        if "://" in path or not os.path.isabs(path):
-            raise SceneError(f"collision mesh {uri!r} is not an absolute path; resolve it (make_description)")
-        if not os.path.isfile(path):
-            raise SceneError(f"collision mesh {path} does not exist")
-        mesh.set("filename", path)
     for old in robot.findall("mujoco"):
         robot.remove(old)
     extension = ET.SubElement(robot, "mujoco")
     ET.SubElement(extension, "compiler", fusestatic="false", discardvisual="true", strippath="false",
                   balanceinertia="true")
-    return ET.tostring(robot, encoding="unicode")
+    return ET.tostring(robot, encoding="unicode"), report
+
+
+def _local_path(uri: str) -> str | None:
+    """The absolute file path of a mesh URI (plain or ``file://``), None for anything else."""
+    path = uri[len("file://"):] if uri.startswith("file://") else uri
+    return path if "://" not in path and os.path.isabs(path) else None
 
 
 @dataclass
@@ -150,6 +190,7 @@ class SceneModel:
         tool_body: Body id of the tool link (pushes are applied at its centre of mass).
         eef_body: Body id of the end-effector frame link.
         payload_mass: Mass below the sensor [kg].
+        geometry: What became of each link's collision geometry (kept, converted, fitted primitive, none).
     """
 
     model: mujoco.MjModel
@@ -169,6 +210,7 @@ class SceneModel:
     tool_body: int
     eef_body: int
     payload_mass: float
+    geometry: list[LinkGeometry] = field(default_factory=list)
 
 
 def _subtree(root: mujoco.MjsBody) -> list[mujoco.MjsBody]:
@@ -194,12 +236,17 @@ def _add_environment(spec: mujoco.MjSpec, cfg: SceneConfig) -> None:
                        pos=list(obs.position), quat=rpy_to_quat(obs.rpy), rgba=[0.8, 0.2, 0.2, 1.0])
 
 
-def build_scene(urdf_xml: str, cfg: SceneConfig) -> SceneModel:
+def build_scene(urdf_xml: str, cfg: SceneConfig, mesh_cache: str | None = None) -> SceneModel:
     """Compile the scene.
+
+    Continuous URDF joints become unlimited hinges (MuJoCo's URDF reader does that; their range is
+    -inf..inf here). Links whose geometry had to be converted or replaced are logged (INFO) and listed
+    in :attr:`SceneModel.geometry`.
 
     Args:
         urdf_xml: The robot description (meshes as absolute paths or ``file://`` URIs).
         cfg: The validated scene settings.
+        mesh_cache: Directory of converted meshes; None = :func:`mujoco_driver.meshes.default_cache_dir`.
 
     Returns:
         The compiled model with its indices.
@@ -209,8 +256,12 @@ def build_scene(urdf_xml: str, cfg: SceneConfig) -> SceneModel:
             slide, or a per-joint setting does not match the URDF's joints.
     """
     limits = urdf_joints(urdf_xml)
+    mjcf_urdf, geometry = mujoco_urdf_report(urdf_xml, mesh_cache)
+    for entry in geometry:
+        if entry.changed:
+            _log.info("%s", entry)
     try:
-        spec = mujoco.MjSpec.from_string(mujoco_urdf(urdf_xml))
+        spec = mujoco.MjSpec.from_string(mjcf_urdf)
     except ValueError as exc:
         raise SceneError(f"MuJoCo cannot read the URDF: {exc}") from exc
     spec.option.timestep = cfg.timestep
@@ -289,4 +340,5 @@ def build_scene(urdf_xml: str, cfg: SceneConfig) -> SceneModel:
         tool_body=model.body(cfg.links.tool).id,
         eef_body=model.body(cfg.links.eef).id,
         payload_mass=float(model.body_subtreemass[sensor_id]),
+        geometry=geometry,
     )

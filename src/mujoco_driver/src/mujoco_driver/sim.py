@@ -64,16 +64,20 @@ class Simulation:
     Args:
         urdf_xml: The robot description (what the ``robot_description`` parameter holds).
         scene_cfg: A :class:`SceneConfig` or the mapping it is read from (``sim.yaml``).
+        mesh_cache: Directory for meshes converted to a format MuJoCo reads (see ``mujoco_driver.meshes``);
+            None = the default cache.
 
     Raises:
         ConfigError: On bad scene settings.
         SceneError: If the URDF and the settings do not make a valid model.
     """
 
-    def __init__(self, urdf_xml: str, scene_cfg: SceneConfig | Mapping[str, Any]) -> None:
+    def __init__(
+        self, urdf_xml: str, scene_cfg: SceneConfig | Mapping[str, Any], mesh_cache: str | None = None
+    ) -> None:
         cfg = scene_cfg if isinstance(scene_cfg, SceneConfig) else SceneConfig.from_dict(scene_cfg)
         self.config = cfg
-        self.scene: SceneModel = build_scene(urdf_xml, cfg)
+        self.scene: SceneModel = build_scene(urdf_xml, cfg, mesh_cache)
         self.model = self.scene.model
         self.data = mujoco.MjData(self.model)
         self.joint_names: tuple[str, ...] = tuple(self.scene.joint_names)
