@@ -40,6 +40,7 @@ from contact_control.axes import (
 from contact_control.laws import AxisLaw
 
 __all__ = [
+    "CODE_NAMES",
     "FAILURE",
     "SET_CARTESIAN_CONTROL_FAILED",
     "SET_CONTROL_FORCE_FAILED",
@@ -66,6 +67,14 @@ SET_DOF_FAILED = -1  # unknown law type on an axis
 SET_CONTROL_FORCE_FAILED = -2  # force/torque limit NaN, negative, above the global limit; exceeded action
 SET_FORCE_STIFFNESS_FAILED = -3  # spring stiffness k <= 0 or NaN
 SET_CARTESIAN_CONTROL_FAILED = -4  # damping, desired velocity or max travel invalid
+CODE_NAMES = {
+    SUCCESS: "SUCCESS",
+    FAILURE: "FAILURE",
+    SET_DOF_FAILED: "SET_DOF_FAILED",
+    SET_CONTROL_FORCE_FAILED: "SET_CONTROL_FORCE_FAILED",
+    SET_FORCE_STIFFNESS_FAILED: "SET_FORCE_STIFFNESS_FAILED",
+    SET_CARTESIAN_CONTROL_FAILED: "SET_CARTESIAN_CONTROL_FAILED",
+}
 
 
 class RequestError(ValueError):

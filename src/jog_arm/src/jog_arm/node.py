@@ -223,8 +223,9 @@ class JogArmNode:
         if self._status_pub.get_num_connections() > 0:  # nobody listening: save the cycle the work
             msg = self._status_msg
             msg.header.stamp = rospy.Time.from_sec(now)
-            msg.code, msg.message, msg.condition_number, msg.speed_scale = (
+            msg.code, msg.code_name, msg.message, msg.condition_number, msg.speed_scale = (
                 int(status),
+                status.name,
                 message,
                 condition,
                 scale,
