@@ -447,6 +447,9 @@ def test_thesis_compliant_move_as_typed_approaches_stops_on_contact_and_moves_aw
     node = fresh
     answer = rosservice(readme_command("move_away: true"))
     assert "success: True" in answer
+    # The laws service says which way a move typed without velocity goes.
+    answer = rosservice(readme_command("/configure_laws \"{z: {law: 3"))
+    assert "success: True" in answer and "z=compliant_move (v -0.01, move_away)" in answer
     down = node.settings.compliant_default_velocity_linear
     wait_twist(node, lambda t: t[2] == pytest.approx(-down), [0] * 6, "the approach at the default velocity")
     # Contact: the table pushes up with 3 N (over the 0.5 N limit): the move ends, Z backs off upward.

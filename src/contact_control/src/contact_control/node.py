@@ -32,6 +32,7 @@ from contact_control.axes import (
     AXES,
     END_NAMES,
     EXCEEDED_ACTION_NAMES,
+    LAW_COMPLIANT_MOVE,
     LAW_NAMES,
     SAFETY_NAMES,
     SAFETY_NO_TF,
@@ -386,12 +387,17 @@ class ContactControlNode:
 
 
 def describe_laws(move_id: int, laws: Sequence[Any]) -> str:
-    """The accepted laws in words, e.g. "contact laws set (move 3): z=compliant_move (move_away)"."""
+    """The accepted laws in words, e.g. "contact laws set (move 3): z=compliant_move (v -0.01, move_away)".
+
+    A compliant move shows its velocity: it may be the default one, in the direction the node chose.
+    """
     parts = []
     for i, law in enumerate(laws):
         if law.law:
-            action = f" ({EXCEEDED_ACTION_NAMES[law.exceeded_action]})" if law.exceeded_action else ""
-            parts.append(f"{AXES[i]}={LAW_NAMES[law.law]}{action}")
+            notes = [f"v {law.velocity:g}"] if law.law == LAW_COMPLIANT_MOVE else []
+            if law.exceeded_action:
+                notes.append(EXCEEDED_ACTION_NAMES[law.exceeded_action])
+            parts.append(f"{AXES[i]}={LAW_NAMES[law.law]}" + (f" ({', '.join(notes)})" if notes else ""))
     return f"contact laws set (move {move_id}): {', '.join(parts) or 'none (all axes still)'}"
 
 
