@@ -62,7 +62,7 @@ class Scenario:
 # and the contact force grows with it) and -0.05 m/s (X, toward the robot
 # base, where both robots have 0.30 m of clear travel). The compliant move backs off from the obstacle once
 # it stops (exceeded_action move_away): a position-controlled arm that stopped on contact otherwise keeps
-# pressing on it with what it overshot (9 N on the simulated UR5).
+# pressing on it with what it overshot (up to 9 N on a simulated arm).
 SCENARIOS: tuple[Scenario, ...] = (
     Scenario(
         name="follower_z",
