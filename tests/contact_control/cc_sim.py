@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -31,13 +32,18 @@ def laws(**per_axis: AxisLaw) -> list[AxisLaw]:
 
 
 class ClosedLoop:
-    """Integrates the commanded twist (control = fixed frame) into the EEF pose, as an ideal robot would."""
+    """Integrates the commanded twist (control = fixed frame) into the EEF pose, as an ideal robot would.
 
-    def __init__(self, ctrl: ContactControl, pose: np.ndarray | None = None) -> None:
+    Args:
+        lag: the arm follows each command this late [s] (a real arm's command-to-motion delay; 0: ideal).
+    """
+
+    def __init__(self, ctrl: ContactControl, pose: np.ndarray | None = None, lag: float = 0.0) -> None:
         self.ctrl = ctrl
         self.pose = np.eye(4) if pose is None else pose.copy()
         self.t = 0.0
         self.results: list = []
+        self._pending: deque = deque([np.zeros(6)] * round(lag / DT))
 
     def start(self, axis_laws: Sequence[AxisLaw]) -> None:
         self.ctrl.set_laws(axis_laws, self.pose, self.t)
@@ -49,7 +55,8 @@ class ClosedLoop:
             w = wrench(self.t, self.pose) if callable(wrench) else wrench
             result = self.ctrl.update(w, self.t, eef_pose=self.pose)
             self.results.append(result)
-            v = np.asarray(result.velocity)
+            self._pending.append(np.asarray(result.velocity))
+            v = self._pending.popleft()
             self.pose[:3, 3] += v[:3] * DT
             if np.any(v[3:]):
                 angle = np.linalg.norm(v[3:]) * DT

@@ -78,11 +78,14 @@ def sensor_wrench(base_wrench) -> list[float]:
     return (R.T @ np.asarray(base_wrench[:3])).tolist() + (R.T @ np.asarray(base_wrench[3:])).tolist()
 
 
-def readme_command() -> str:
+def readme_command(containing: str = "/configure_cartesian_impedance ") -> str:
+    """The first `rosservice call` of the README's executed examples that contains `containing`."""
     text = (PKG / "README.md").read_text()
-    match = re.search(r"README example executed by tests.*?```bash\n(rosservice call .*?)\n```", text, re.S)
-    assert match, "README lost its executed rosservice example"
-    return match.group(1)
+    blocks = re.findall(r"README example executed by tests.*?```bash\n(.*?)\n```", text, re.S)
+    commands = [line for block in blocks for line in block.splitlines() if line.startswith("rosservice call")]
+    found = [c for c in commands if containing in c]
+    assert found, f"README lost its executed rosservice example with {containing!r}"
+    return found[0]
 
 
 @pytest.fixture(scope="module")
@@ -116,9 +119,7 @@ def node(ros_node, tmp_path_factory):
 
 
 def rosservice(command: str) -> str:
-    command = command.replace(
-        "call /configure_cartesian_impedance", f"call {NS}/configure_cartesian_impedance", 1
-    )
+    command = command.replace("call /", f"call {NS}/", 1)
     done = subprocess.run(shlex.split(command), capture_output=True, text=True, timeout=30)
     assert done.returncode == 0, done.stderr
     return done.stdout
@@ -262,7 +263,13 @@ def test_bad_request_is_refused_and_the_previous_law_keeps_running(fresh):
     twist = wait_twist(node, lambda t: t[2] == pytest.approx(-0.2), [0, 0, -6.0, 0, 0, 0], "still following")
     assert twist[0] == 0.0
     status = latest_status(node, lambda s: "refused" in s.message, "the refusal in ~status")
-    assert "code -3" in status.message and "stiffness" in status.message and status.move_active
+    assert "code -3" in status.message and status.move_active
+    assert "X reads cart_impedance_params.stiffness.translational.x; got 0.0" in status.message
+    assert status.safety_name == "ok" and status.axes[2].law_name == "follower"
+    # The log's warning starts with the reason (the original response has no field for it).
+    wait_until(lambda: re.search(r"\[WARN\] \[[\d.]+\]: axis x \(spring\): stiffness", node.h.output()), 10,
+               "the refusal reason at the start of a warning")
+    assert status.axes[2].end_condition_name == "none" and status.axes[0].law_name == "none"
 
 
 def test_nan_wrench_gives_zero_twist_and_a_reason_then_resumes(fresh):
@@ -433,3 +440,53 @@ def test_queued_publishing_mode_still_answers_each_push_with_a_follower_twist(ro
         finally:
             twists.close()
             pub.unregister()
+
+
+def test_thesis_compliant_move_as_typed_approaches_stops_on_contact_and_moves_away(fresh):
+    """README: force limit -0.5 N and damping, no desired velocity, exceeded_action move_away."""
+    node = fresh
+    answer = rosservice(readme_command("move_away: true"))
+    assert "success: True" in answer
+    # The laws service says which way a move typed without velocity goes.
+    answer = rosservice(readme_command("/configure_laws \"{z: {law: 3"))
+    assert "success: True" in answer and "z=compliant_move (v -0.01, move_away)" in answer
+    down = node.settings.compliant_default_velocity_linear
+    wait_twist(node, lambda t: t[2] == pytest.approx(-down), [0] * 6, "the approach at the default velocity")
+    # Contact: the table pushes up with 3 N (over the 0.5 N limit): the move ends, Z backs off upward.
+    away = node.settings.move_away_velocity_linear
+    wait_twist(node, lambda t: t[2] == pytest.approx(away), [0, 0, 3.0, 0, 0, 0], "backing off", timeout=15)
+    status = latest_status(node, lambda s: s.reacting, "reacting in ~status",
+                           keep_publishing=([0, 0, 3.0, 0, 0, 0], "ft_sensor"))
+    z = status.axes[2]
+    assert not status.move_active and z.reacting and z.exceeded_action == "move_away"
+    assert z.end_condition_name == "force/torque limit" and z.law_name == "compliant_move"
+    # Released (0.1 N is below half the limit): it holds, and says so.
+    wait_twist(node, lambda t: t == [0.0] * 6, [0, 0, 0.1, 0, 0, 0], "holding once released")
+    status = latest_status(node, lambda s: not s.reacting and "moved away" in s.message, "the release",
+                           keep_publishing=([0, 0, 0.1, 0, 0, 0], "ft_sensor"))
+    assert status.axes[2].end_condition == 1
+
+
+def test_configure_laws_answers_with_the_reason_and_a_refusal_changes_nothing(fresh):
+    import rospy
+    from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsRequest
+
+    node = fresh
+    answer = rosservice(readme_command("/configure_laws \"{z:"))
+    assert "success: True" in answer and "code: 1" in answer and "z=follower" in answer
+    wait_twist(node, lambda t: t[2] == pytest.approx(0.2), [0, 0, 6.0, 0, 0, 0], "the follower to follow")
+    answer = rosservice(readme_command("/configure_laws \"{rx:"))
+    assert "success: False" in answer and "code: -4" in answer
+    assert "RX reads rx.damping; got 0.0" in answer
+    # Nothing changed: Z still follows (the other way now), RX does not move under a torque.
+    pushed = [0, 0, -6.0, 6.0, 0, 0]
+    twist = wait_twist(node, lambda t: t[2] == pytest.approx(-0.2), pushed, "still following")
+    assert twist[3] == 0.0
+    # The same through a proxy: an action without a force limit could never act, so it is refused.
+    call = rospy.ServiceProxy(f"{NS}/configure_laws", ConfigureLaws)
+    req = ConfigureLawsRequest()
+    req.x.law, req.x.damping, req.x.exceeded_action = 1, 30.0, 1
+    response = call(req)
+    assert not response.success and "set x.force_limit > 0" in response.message
+    status = latest_status(node, lambda s: "refused" in s.message, "the refusal in ~status")
+    assert status.move_active and status.axes[2].law_name == "follower"

@@ -60,7 +60,7 @@ def test_one_joint_command_per_twist_in_the_push_direction_with_the_usual_servic
     twists, commands = Collector(TWIST, TwistStamped), Collector(COMMAND, Float64MultiArray)
     try:
         with run_node("control_stack", "control_stack_node", args=[f"__ns:={NS}"]) as h:
-            for service in ("configure_cartesian_impedance", "contact_control_node/stop",
+            for service in ("configure_cartesian_impedance", "configure_laws", "contact_control_node/stop",
                             "jog_arm_server/pause", "jog_arm_server/cycle_stats"):
                 h.wait_for_service(f"{NS}/{service}", timeout=30)
             wait_until(lambda: wrench.get_num_connections() > 0, 20, "the stack to subscribe to the wrench")

@@ -161,6 +161,7 @@ def test_replayed_state_twist_in_trajectory_out_then_stale_stop_and_refusals(ros
             sender.pub.publish(twist_msg((math.nan, 0.0, 0.0, 0.0, 0.0, 0.0)))
             wait_until(lambda: status.last().code == StatusCode.INVALID_COMMAND, 10, "INVALID_COMMAND")
             assert "non-finite" in status.last().message
+            assert status.last().code_name == "INVALID_COMMAND"  # rostopic echo reads the code in words
             seen = len(status.msgs)
             wait_until(lambda: len(status.msgs) > seen + 20, 10, "20 more cycles")
             assert not commands.msgs

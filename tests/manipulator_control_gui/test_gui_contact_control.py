@@ -34,6 +34,7 @@ def test_apply_refusal_and_stop_with_the_real_node(contact_control, qapp, pump):
         widget.show()
         pump(lambda: widget.connection_label.text().startswith("Connected"), 20, "the connection line")
         assert "/configure_cartesian_impedance" in widget.connection_label.text()
+        pump(lambda: "laws via /configure_laws" in widget.connection_label.text(), 20, "ConfigureLaws")
 
         widget.load_preset("hybrid")
         click(widget.apply_button)
@@ -55,7 +56,7 @@ def test_apply_refusal_and_stop_with_the_real_node(contact_control, qapp, pump):
         pump(lambda: "(error " in widget.answer_label.text(), 20, "the refusal with its reason")
         text = widget.answer_label.text()
         assert text.startswith("Refused: axis x") and "SET_CARTESIAN_CONTROL_FAILED, -4" in text
-        assert "0.3" in text
+        assert "X reads x.velocity; got 0.3" in text  # ConfigureLaws's answer names the field
 
         # The node still works after the refusal.
         click(widget.stop_button)

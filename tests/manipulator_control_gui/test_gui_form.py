@@ -1,4 +1,5 @@
-"""The Qt-free form: form -> ConfigureForceControl request, refusals before sending, presets, answers."""
+"""The Qt-free form: form -> ConfigureForceControl / ConfigureLaws request, refusals before sending, presets,
+answers."""
 
 import dataclasses
 import io
@@ -7,10 +8,13 @@ import math
 import pytest
 import yaml
 from cartesian_impedance_msgs.srv import ConfigureForceControlRequest
-from contact_control.request import validate_request
+from compliant_control_msgs.srv import ConfigureLawsRequest
+from contact_control.request import validate_laws_request, validate_request
 from manipulator_control_gui.form import (
+    EXCEEDED_ACTIONS,
     AxisForm,
     FormError,
+    build_laws_request,
     build_request,
     default_form,
     describe_response,
@@ -353,3 +357,45 @@ def test_summary_and_saved_form_round_trip():
     damaged["z"]["damping"] = "lots"
     restored = form_from_dict(damaged)
     assert restored["x"] == AxisForm() and restored["z"] == dataclasses.replace(form["z"], damping=0.0)
+
+
+@pytest.mark.parametrize("law", LAWS)
+@pytest.mark.parametrize("axis", AXES)
+def test_every_law_on_every_axis_maps_to_the_configure_laws_request(axis, law):
+    row = AxisForm(law, **VALUES)
+    req = build_laws_request(CONFIG, form_with(**{axis: row}), action="move_away")
+    assert isinstance(req, ConfigureLawsRequest)
+    names = {"damping": "damping", "stiffness": "stiffness", "velocity": "velocity",
+             "max_force": "force_limit", "max_deviation": "max_travel"}
+    for other in AXES:
+        target = getattr(req, other)
+        assert target.law == (LAW_TYPE[law] if other == axis else 0)
+        for field, slot_name in names.items():
+            expected = VALUES[field] if other == axis and field in LAW_FIELDS[law] else 0.0
+            assert getattr(target, slot_name) == expected, (other, field)
+        # The action goes to the axes with a max force (as contact_control maps the original's one flag).
+        assert target.exceeded_action == (1 if other == axis and law != "none" else 0)
+    decoded = validate_laws_request(req)[AXES.index(axis)]
+    assert decoded.law == LAW_TYPE[law]
+
+
+@pytest.mark.parametrize("action", list(EXCEEDED_ACTIONS))
+def test_the_chosen_exceeded_action_is_the_one_flag_sent(action):
+    form = form_with(z=AxisForm("compliant_move", damping=30.0, velocity=-0.02, max_force=0.5))
+    flags = build_request(CONFIG, form, action=action).cart_impedance_params.max_ctrl_force.exceeded_action
+    sent = {name: getattr(flags, name) for name in EXCEEDED_ACTIONS}
+    assert sent == {name: name == action for name in EXCEEDED_ACTIONS}
+    assert validate_request(build_request(CONFIG, form, action=action))[2].exceeded_action == (
+        EXCEEDED_ACTIONS[action][0]
+    )
+
+
+def test_an_exceeded_action_contact_control_would_refuse_is_caught_before_sending():
+    # Gravity compensation makes the axis a follower after the limit: a compliant move needs b > 0 for that.
+    form = form_with(z=AxisForm("compliant_move", damping=0.0, velocity=-0.02, max_force=0.5))
+    for build in (build_request, build_laws_request):
+        with pytest.raises(FormError) as err:
+            build(CONFIG, form, action="gravity_compensation")
+        assert err.value.code == -4 and "damping" in err.value.message
+    with pytest.raises(FormError, match="Unknown action"):
+        build_laws_request(CONFIG, form, action="explode")

@@ -5,6 +5,7 @@ from compliant_control_msgs.msg import AxisState, ContactControlStatus
 from manipulator_control_gui.readout import (
     END_TEXT,
     LAW_TEXT,
+    REACTION_TEXT,
     SAFETY_TEXT,
     readout_from_status,
     refusal_in_status,
@@ -76,6 +77,29 @@ def test_safety_stop_reads_as_not_ok():
     assert readout.state.startswith("move running · safety force over the global limit")
 
 
+def test_exceeded_action_after_the_move_is_shown_on_its_axis():
+    status = make_status()
+    status.reacting = True
+    status.axes[2].exceeded_action, status.axes[2].reacting = "move_away", True
+    readout = readout_from_status(status)
+    assert readout.state.startswith("move ended, exceeded action running · safety ok")
+    assert readout.axes["z"].end == "ended: force/torque limit · moving away from the contact"
+    status.axes[2].exceeded_action = "gravity_compensation"
+    assert readout_from_status(status).axes["z"].end.endswith("hand-guiding (gravity compensation)")
+    assert set(REACTION_TEXT) == {"move_away", "gravity_compensation"}
+    status.reacting = status.axes[2].reacting = False  # done: back to the plain end condition
+    readout = readout_from_status(status)
+    assert readout.axes["z"].end == "ended: force/torque limit" and readout.state.startswith("no move")
+
+
+def test_codes_this_panel_does_not_know_read_as_the_names_the_node_sends():
+    status = make_status()
+    status.safety, status.safety_name = 9, "new safety state"
+    status.axes[2].end_condition, status.axes[2].end_condition_name = 8, "new end condition"
+    readout = readout_from_status(status)
+    assert "safety new safety state" in readout.state and readout.axes["z"].end == "ended: new end condition"
+
+
 def test_refusal_reason_is_read_from_the_status_message():
     message = (
         "move ended: z force limit; last request refused (code -4): axis x (compliant_move): desired velocity"
@@ -85,5 +109,8 @@ def test_refusal_reason_is_read_from_the_status_message():
         99999,
         "safety latched (over limit)",
     )
+    reason = "axis rx (follower): damping b > 0; RX reads cart_impedance_params.damping.rotational.x; got 0.0"
+    message = f"move ended: z: max travel; last request refused (code -4): {reason}"
+    assert refusal_in_status(message) == (-4, reason)  # the reason's own "; " do not cut it short
     assert refusal_in_status("move ended: z force limit") is None
     assert refusal_in_status("") is None

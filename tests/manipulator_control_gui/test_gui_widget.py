@@ -13,6 +13,7 @@ import pytest
 from cartesian_impedance_msgs.msg import CartesianForceCtrlErrorCodes
 from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlResponse
 from compliant_control_msgs.msg import AxisState, ContactControlStatus
+from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsResponse
 from manipulator_control_gui.form_config import AXES, load_config
 from manipulator_control_gui.ros_client import RosNames
 from std_srvs.srv import Trigger, TriggerResponse
@@ -27,9 +28,10 @@ _ids = itertools.count()
 class FakeContactControl:
     """Services and status topic shaped like contact_control_node's, recording every call."""
 
-    def __init__(self, rospy, ns: str, success: bool = True) -> None:
+    def __init__(self, rospy, ns: str, success: bool = True, laws: bool = False) -> None:
         self.rospy = rospy
         self.requests: list = []
+        self.laws_requests: list = []
         self.triggers: list[str] = []
         self.success = success
         self.gate = threading.Event()
@@ -38,6 +40,8 @@ class FakeContactControl:
         self.services = [
             rospy.Service(f"{ns}/configure_cartesian_impedance", ConfigureForceControl, self._configure)
         ]
+        if laws:  # a contact_control that also offers ConfigureLaws
+            self.services.append(rospy.Service(f"{ns}/configure_laws", ConfigureLaws, self._configure_laws))
         for name in ("stop", "tare", "reset"):
             self.services.append(
                 rospy.Service(f"{node}/{name}", Trigger, lambda _req, n=name: self._trigger(n))
@@ -49,6 +53,14 @@ class FakeContactControl:
         self.gate.wait(30.0)  # a test may hold the answer back to show the window keeps running
         # The reply's error message declares constants only (as the original): no code travels.
         return ConfigureForceControlResponse(success=self.success, error=CartesianForceCtrlErrorCodes())
+
+    def _configure_laws(self, req):
+        self.laws_requests.append(req)
+        if self.success:
+            message = "contact laws set (move 1): z=compliant_move (move_away)"
+            return ConfigureLawsResponse(success=True, code=1, message=message)
+        reason = "axis z (follower): damping b must be finite and > 0; Z reads z.damping; got 0.0"
+        return ConfigureLawsResponse(success=False, code=-4, message=reason)
 
     def _trigger(self, name: str) -> TriggerResponse:
         self.triggers.append(name)
@@ -157,7 +169,8 @@ def test_apply_sends_what_the_user_filled_in(fake, ns, make_widget, pump):
     assert p.max_cart_vel.set.angular.z == -0.1 and p.max_cart_vel.set.linear.z == 0.0
     assert p.max_ctrl_force.set.torque.z == 0.5 and p.max_path_deviation.rotation.z == 0.5
     assert p.damping.rotational.z == 30.0
-    assert p.max_ctrl_force.exceeded_action.stop
+    assert p.max_ctrl_force.exceeded_action.stop  # the default choice
+    assert not p.max_ctrl_force.exceeded_action.move_away
     assert "Applied: contact control accepted the laws." == widget.answer_label.text()
 
 
@@ -183,6 +196,31 @@ def test_a_refusal_is_shown_in_plain_words(ros_node, ns, make_widget, pump):
         assert widget.answer_label.text() == (
             "Refused: axis x (spring): stiffness k must be > 0 (error SET_FORCE_STIFFNESS_FAILED, -3)."
         )
+    finally:
+        server.close()
+
+
+@pytest.mark.parametrize("success", [True, False])
+def test_configure_laws_is_used_when_offered_and_its_reason_shown(ros_node, ns, make_widget, pump, success):
+    server = FakeContactControl(ros_node, ns, success=success, laws=True)
+    try:
+        widget = make_widget(ns)
+        pump(lambda: "laws via" in widget.connection_label.text(), message="ConfigureLaws to be found")
+        assert f"{ns}/configure_laws" in widget.connection_label.text()
+        widget.load_preset("compliant_move_z")
+        widget.set_exceeded_action("move_away")
+        click(widget.apply_button)
+        pump(lambda: server.laws_requests, message="the request at configure_laws")
+        word = "Applied" if success else "Refused"
+        pump(lambda: widget.answer_label.text().startswith(word), message="the answer line")
+        assert not server.requests  # the original service was not called
+        z = server.laws_requests[0].z
+        assert (z.law, z.force_limit, z.exceeded_action) == (3, 0.5, 1)  # move away on the limited axis
+        if not success:  # the reason comes with the answer, no status needed
+            assert widget.answer_label.text() == (
+                "Refused: axis z (follower): damping b must be finite and > 0; Z reads z.damping; got 0.0 "
+                "(error SET_CARTESIAN_CONTROL_FAILED, -4)."
+            )
     finally:
         server.close()
 
@@ -394,11 +432,14 @@ def test_rqt_plugin_builds_the_panel_and_keeps_the_form(qapp, ros_node):
         assert plugin.widget.windowTitle() == "Manipulator control (2)"
         assert plugin.widget.client.resolved.status_topic == "/contact_control_node/status"
         plugin.widget.load_preset("spring_x")
+        plugin.widget.set_exceeded_action("gravity_compensation")
         settings = FakeSettings()
         plugin.save_settings(FakeSettings(), settings)
         plugin.widget.load_preset("follower_z")
+        plugin.widget.set_exceeded_action("stop")
         plugin.restore_settings(FakeSettings(), settings)
         assert plugin.widget.form()["x"].law == "spring" and plugin.widget.form()["z"].law == "none"
+        assert plugin.widget.exceeded_action == "gravity_compensation"
         settings.set_value("form", "{not json")
         plugin.restore_settings(FakeSettings(), settings)  # ignored, form unchanged
         assert plugin.widget.form()["x"].law == "spring"

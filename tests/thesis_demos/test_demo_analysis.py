@@ -48,18 +48,22 @@ def test_follower_fails_when_the_side_push_moves_the_arm():
 def test_compliant_move_needs_force_stop_low_peak_and_hold():
     scenario = by_name(["compliant_move_z"])[0]
 
-    def rec(ends, peak):
+    def rec(ends, peak, residual=0.05):
         return _recording(
             5.0,
             z=_ramp(0.0, 2.5, -0.03),
             ends={"z": ends},
             end_time=2.5,
-            contact_z=lambda t: peak if 2.4 < t < 2.6 else 0.0,
+            contact_z=lambda t: peak if 2.4 < t < 2.6 else residual if t > 2.6 else 0.0,
         )
 
-    assert judge(scenario, rec(1, 3.0)).passed
+    assert scenario.exceeded_action == "move_away"
+    verdict = judge(scenario, rec(1, 3.0))
+    assert verdict.passed and "residual contact force 0.05 N" in verdict.summary
     assert not judge(scenario, rec(2, 3.0)).passed, "ended by travel, not by contact"
     assert not judge(scenario, rec(1, CONTACT_FORCE_BOUND + 1)).passed, "pressed too hard"
+    pressing = judge(scenario, rec(1, 9.5, residual=9.1))  # stopped, but kept pressing on the obstacle
+    assert not pressing.passed and pressing.figures["residual contact force [N]"] == pytest.approx(9.1)
 
 
 def test_spring_return_and_overshoot():

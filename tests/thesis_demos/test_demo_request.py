@@ -17,3 +17,12 @@ def test_hybrid_request_maps_each_axis_to_its_fields():
     assert p.max_ctrl_force.set.force.x == 0.5
     assert (p.damping.translational.z, p.stiffness.translational.z) == (30.0, 100.0)
     assert p.max_ctrl_force.set.force.z == 0.0, "no force limit on the spring axis"
+
+
+def test_compliant_move_asks_to_move_away_and_the_others_to_stop():
+    from thesis_demos.scenarios import by_name
+
+    action = runner.build_request(by_name(["compliant_move_z"])[0]).cart_impedance_params.max_ctrl_force
+    assert (action.exceeded_action.move_away, action.exceeded_action.stop) == (True, False)
+    action = runner.build_request(by_name(["hybrid"])[0]).cart_impedance_params.max_ctrl_force
+    assert (action.exceeded_action.move_away, action.exceeded_action.stop) == (False, True)

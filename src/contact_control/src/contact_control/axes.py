@@ -17,6 +17,10 @@ __all__ = [
     "END_NAMES",
     "END_NONE",
     "END_NO_FT_DATA",
+    "EXCEEDED_ACTION_NAMES",
+    "EXCEEDED_GRAVITY_COMPENSATION",
+    "EXCEEDED_MOVE_AWAY",
+    "EXCEEDED_STOP",
     "LAW_COMPLIANT_MOVE",
     "LAW_FOLLOWER",
     "LAW_NAMES",
@@ -65,6 +69,16 @@ END_NAMES = {
     END_DIFF_VIOLATION: "force jump",
     END_NO_FT_DATA: "no F/T data",
     END_EXTERNAL_STOP: "external stop",
+}
+
+# compliant_control_msgs/AxisLaw ACTION_*: what an axis does once the move ends on a force/torque limit
+EXCEEDED_STOP = 0  # hold (every axis holds when a move ends)
+EXCEEDED_MOVE_AWAY = 1  # back off along the measured force until below a fraction of the limit, then hold
+EXCEEDED_GRAVITY_COMPENSATION = 2  # become a follower with the axis's damping (hand-guiding)
+EXCEEDED_ACTION_NAMES = {
+    EXCEEDED_STOP: "stop",
+    EXCEEDED_MOVE_AWAY: "move_away",
+    EXCEEDED_GRAVITY_COMPENSATION: "gravity_compensation",
 }
 
 # compliant_control_msgs/ContactControlStatus SAFETY_*

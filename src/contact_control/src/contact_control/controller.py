@@ -11,6 +11,8 @@ Decisions (the README repeats them):
 - Wrench over `global_max_force`/`global_max_torque`: zero output, the move ends (FT_VIOLATION on its active
   axes) and the safety stays latched, refusing new laws, until `reset_safety()`.
 - After any pause the velocity restarts from zero under the acceleration limit.
+- A move that ended on a force/torque limit hands over to the axes' exceeded actions (`exceeded`): move away
+  from the contact or gravity compensation. Twists keep coming while one runs (`CycleResult.commanding`).
 
 Not thread-safe: the node serialises calls with one lock.
 """
@@ -39,6 +41,7 @@ from contact_control.axes import (
     SAFETY_OVER_LIMIT,
     SAFETY_STALE,
 )
+from contact_control.exceeded import ExceededReaction
 from contact_control.laws import AxisLaw, ForceWindow, check_end, law_velocity, shape_velocity
 from contact_control.params import ContactControlSettings
 from contact_control.preprocess import PreprocessError, WrenchPreprocessor, is_finite6
@@ -76,15 +79,19 @@ class CycleResult:
         safety: SAFETY_* code; message: why, in words ('' when all is well).
         ended_axis: index of the axis that ended the move, -1 if none or not a single axis.
         move_id: counts `set_laws` calls.
+        reacting: per axis, carrying out its exceeded action after the move ended (moving away, following).
+        actions: per axis, the exceeded action (EXCEEDED_*) of its law; -1 on axes without a force limit.
     """
 
     __slots__ = (
+        "actions",
         "end_conditions",
         "ended_axis",
         "laws",
         "message",
         "move_active",
         "move_id",
+        "reacting",
         "safety",
         "t",
         "travel",
@@ -105,6 +112,8 @@ class CycleResult:
         message: str,
         ended_axis: int,
         move_id: int,
+        reacting: list[bool] | None = None,
+        actions: list[int] | None = None,
     ) -> None:
         self.t = t
         self.velocity = velocity
@@ -117,6 +126,13 @@ class CycleResult:
         self.message = message
         self.ended_axis = ended_axis
         self.move_id = move_id
+        self.reacting = reacting if reacting is not None else [False] * 6
+        self.actions = actions if actions is not None else [-1] * 6
+
+    @property
+    def commanding(self) -> bool:
+        """Twists are due: a move runs, or an axis carries out its exceeded action after it."""
+        return self.move_active or any(self.reacting)
 
     @property
     def twist(self) -> np.ndarray:
@@ -166,6 +182,8 @@ class ContactControl:
         self._from_rest: float | None = None  # when the axes last started from rest
         self._meter = TravelMeter(s.travel_directions)
         self._travel_offset = [0.0] * 6  # travel of an axis whose law changed during a move, at the change
+        self._reaction = ExceededReaction(self._tuning, s.move_away_release_fraction)
+        self._actions = [-1] * 6  # per axis: EXCEEDED_* of its law, -1 without a force limit
         self._laws: list[AxisLaw] = [AxisLaw()] * 6
         self._law_types = [LAW_NONE] * 6
         self._active: tuple[int, ...] = ()
@@ -207,8 +225,8 @@ class ContactControl:
 
     def move_outcome(self, move_id: int) -> bool | None:
         """None while move `move_id` runs; then whether it ended by an axis end condition (see `end_ok`)."""
-        if move_id == self._move_id and self._move_active:
-            return None
+        if move_id == self._move_id and (self._move_active or self._reaction.moving_away):
+            return None  # a blocking caller hears of the end once the press is released
         return self._outcomes.get(move_id, False)
 
     @property
@@ -263,8 +281,10 @@ class ContactControl:
         if self._move_active:
             self._end_move(-1, END_EXTERNAL_STOP, False, "replaced by a new request")
         self._travel_offset = [0.0] * 6
+        self._reaction.clear()
         self._laws = laws
         self._law_types = [law.law for law in laws]
+        self._actions = [law.exceeded_action if law.law and law.force_limit > 0.0 else -1 for law in laws]
         self._active = tuple(i for i in range(6) if laws[i].law != LAW_NONE)
         self._diff_axes = tuple(i for i in self._active if self._diff[i] > 0.0)
         self._needs_travel = any(law.law != LAW_FOLLOWER or law.max_travel > 0.0 for law in laws if law.law)
@@ -308,6 +328,7 @@ class ContactControl:
             self._from_rest = t
         self._laws = laws
         self._law_types = [law.law for law in laws]
+        self._actions = [law.exceeded_action if law.law and law.force_limit > 0.0 else -1 for law in laws]
         self._active = tuple(i for i in range(6) if laws[i].law != LAW_NONE)
         self._diff_axes = tuple(i for i in self._active if self._diff[i] > 0.0)
         self._needs_travel = any(law.law != LAW_FOLLOWER or law.max_travel > 0.0 for law in laws if law.law)
@@ -332,9 +353,9 @@ class ContactControl:
         return self._hold(t, SAFETY_STALE, f"{description}: timing reset, holding until fresh data")
 
     def stop(self, reason: str = "stop requested") -> bool:
-        """Ends the running move (EXTERNAL_STOP); returns whether one was running."""
+        """Ends the running move (EXTERNAL_STOP) or exceeded action; returns whether one was running."""
         if not self._move_active:
-            return False
+            return self._stop_reaction(reason)
         self._end_move(-1, END_EXTERNAL_STOP, False, reason)
         return True
 
@@ -403,6 +424,8 @@ class ContactControl:
             return self._hold(t, SAFETY_OVER_LIMIT, self._latch_message)
         self._wrench = w
         if not self._move_active:
+            if self._reaction.active:
+                return self._react(t, w)
             return self._result(t, SAFETY_OK, "")
         travel = self._travel
         if eef_pose is not None:
@@ -454,6 +477,8 @@ class ContactControl:
                 since = self._move_t0
             if since is not None and t - since >= self._end_timeout:
                 self._end_move(-1, END_NO_FT_DATA, False, f"no wrench for {t - since:.3f} s")
+        elif self._reaction.active and last is not None and t - last >= self._end_timeout:
+            self._stop_reaction(f"no wrench for {t - last:.3f} s")
         age = "no wrench received yet" if last is None else f"no wrench for {t - last:.3f} s"
         if self._latched:  # the latch outranks staleness: it needs a reset, data alone will not clear it
             return self._hold(t, SAFETY_OVER_LIMIT, f"{self._latch_message}; {age}")
@@ -472,7 +497,8 @@ class ContactControl:
     # --- internals ---
     def _result(self, t: float, safety: int, message: str) -> CycleResult:
         if not message and not self._move_active:
-            message = self._end_message
+            note = self._reaction.note
+            message = f"{self._end_message}; {note}" if note else self._end_message
         result = CycleResult(
             t,
             list(self._v),
@@ -485,6 +511,8 @@ class ContactControl:
             message,
             self._ended_axis,
             self._move_id,
+            self._reaction.reacting(),
+            self._actions,
         )
         self.last_result = result
         return result
@@ -506,7 +534,28 @@ class ContactControl:
         else:
             why = f"force changed by more than {self._diff[axis]} within the window"
         self._end_move(axis, condition, True, f"axis {name}: {END_NAMES[condition]}: {why}")
+        if condition == END_FT_VIOLATION and self._reaction.start(self._laws, self._wrench):
+            for i in self._reaction.follower_axes():
+                self._law_types[i] = LAW_FOLLOWER  # gravity compensation: what the axis runs now
         return self._hold(t, SAFETY_OK, "")
+
+    def _react(self, t: float, w: list[float]) -> CycleResult:
+        """A cycle of the exceeded actions after the move ended (`exceeded.ExceededReaction`)."""
+        last = self._last_t
+        dt = self._dt_nominal if last is None else min(max(t - last, 0.0), self._timeout)
+        self._last_t = t
+        self._reaction.step(w, self._v, dt)
+        return self._result(t, SAFETY_OK, "")
+
+    def _stop_reaction(self, reason: str) -> bool:
+        """Ends the exceeded actions (stop, missing data); returns whether one ran."""
+        if not self._reaction.active:
+            return False
+        self._reaction.clear()
+        self._law_types = [law.law for law in self._laws]
+        self._v = [0.0] * 6
+        self._end_message = f"{self._end_message}; exceeded action ended: {reason}"
+        return True
 
     def _end_move(self, axis: int, condition: int, ok: bool, message: str) -> None:
         self._end = [END_NONE] * 6
@@ -528,6 +577,8 @@ class ContactControl:
         torque = (w[3] ** 2 + w[4] ** 2 + w[5] ** 2) ** 0.5 if w else float("nan")
         p = self.preprocessor
         self._latched = True
+        self._reaction.clear()  # nothing moves after a safety trip, whatever the exceeded action said
+        self._v = [0.0] * 6
         self._latch_message = (
             f"wrench over the global limit (|F| {force:.1f} N of {p.max_force} N, |T| "
             f"{torque:.1f} Nm of {p.max_torque} Nm): holding until reset"

@@ -25,6 +25,7 @@ from contact_control.axes import (
     END_FT_VIOLATION,
     END_MAX_TRAVEL,
     END_NONE,
+    EXCEEDED_STOP,
     LAW_COMPLIANT_MOVE,
     LAW_FOLLOWER,
     LAW_NONE,
@@ -47,6 +48,8 @@ class AxisLaw:
         force_limit: |F| at or above this ends the move (FT_VIOLATION); 0: no limit.
         max_travel: |d| at or above this ends the move (MAX_TRAVEL); 0: no limit.
         offset: d_offset of the spring law [m] or [rad].
+        exceeded_action: EXCEEDED_STOP, EXCEEDED_MOVE_AWAY or EXCEEDED_GRAVITY_COMPENSATION: what this axis
+            does once the move has ended on a force limit (see `exceeded.ExceededReaction`).
     """
 
     law: int = LAW_NONE
@@ -56,6 +59,7 @@ class AxisLaw:
     force_limit: float = 0.0
     max_travel: float = 0.0
     offset: float = 0.0
+    exceeded_action: int = EXCEEDED_STOP
 
 
 def round_to(value: float, step: float) -> float:

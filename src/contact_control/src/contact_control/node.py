@@ -4,8 +4,10 @@ Per wrench: look up the transforms (static ones are cached, each frame at most o
 robot model instead of tf when jog_arm shares the process, see control_stack), run one
 `ContactControl.update` and publish the twist at once (lowest latency). A thread wakes when the newest
 wrench turns stale and then keeps publishing zero at ~control_rate while a move waits for data. Twists are
-published while a move is active, then `idle_zero_count` zeros after it ends, then nothing, so other
-sources (keyboard jogging) can use the same topic in between.
+published while a move is active (or an axis carries out its exceeded action after it), then
+`idle_zero_count` zeros after it ends, then nothing, so other sources (keyboard jogging) can use the same
+topic in between. Laws come from the original ConfigureForceControl services or from ConfigureLaws
+(`configure_laws`, per axis, answering with the reason).
 """
 
 from __future__ import annotations
@@ -26,10 +28,19 @@ from compliant_common.master import MasterWatch
 from compliant_common.ros_time import JumpAwareClock, sleep_through_jumps, timer
 from compliant_common.runtime import tune_runtime
 from compliant_control_msgs.msg import AxisState, ContactControlStatus
+from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsResponse
 from geometry_msgs.msg import TwistStamped, WrenchStamped
 from std_srvs.srv import Trigger, TriggerResponse
 
-from contact_control.axes import AXES, SAFETY_NO_TF
+from contact_control.axes import (
+    AXES,
+    END_NAMES,
+    EXCEEDED_ACTION_NAMES,
+    LAW_COMPLIANT_MOVE,
+    LAW_NAMES,
+    SAFETY_NAMES,
+    SAFETY_NO_TF,
+)
 from contact_control.controller import ContactControl, CycleResult
 from contact_control.frames import (
     IDENTITY,
@@ -42,9 +53,22 @@ from contact_control.frames import (
 )
 from contact_control.params import PARAMETERS, ContactControlSettings, ParamError, load_settings
 from contact_control.preprocess import PreprocessError
-from contact_control.request import RequestError, RequestLimits, validate_request
+from contact_control.request import (
+    CODE_NAMES,
+    SUCCESS,
+    RequestError,
+    RequestLimits,
+    validate_laws_request,
+    validate_request,
+)
 
-__all__ = ["ContactControlNode", "main", "read_settings"]
+__all__ = [
+    "ContactControlNode",
+    "describe_laws",
+    "fill_status_words",
+    "main",
+    "read_settings",
+]
 
 _ZERO = (0.0,) * 6
 FAULT_SHOWN_FOR = 1.0  # [s] a clock jump stays on ~status at least this long, so a 50 Hz reader sees it
@@ -103,6 +127,8 @@ class ContactControlNode:
         self._fault_note = ""  # a clock jump or a lost master, for ~status until it is over
         self._fault_shown_until = 0.0  # [s, monotonic] a past fault stays on ~status at least this long
         self._clock = JumpAwareClock()
+        self._refusal = RequestError(SUCCESS, "")
+        self._accepted = ""
         self._twist_sink = twist_sink
         self._own_subscribers = own_subscribers
         self._twist = TwistStamped()
@@ -122,6 +148,7 @@ class ContactControlNode:
             rospy.Service(
                 "configure_cartesian_impedance_blocking", ConfigureForceControl, self._on_configure_blocking
             ),
+            rospy.Service("configure_laws", ConfigureLaws, self._on_configure_laws),
             rospy.Service(private_ns + "tare", Trigger, self._on_tare),
             rospy.Service(private_ns + "stop", Trigger, self._on_stop),
             rospy.Service(private_ns + "reset", Trigger, self._on_reset),
@@ -267,7 +294,7 @@ class ContactControlNode:
 
     def _publish(self, result: CycleResult, t: float, R_command_control: Any = None) -> None:
         """Twist out according to the publish policy; wakes blocking callers when a move ends."""
-        if result.move_active:
+        if result.commanding:  # a move, or an exceeded action after it (moving away, hand-guiding)
             self._idle_zeros = int(self._s.idle_zero_count)
             v = result.velocity
             if R_command_control is not None and any(v):
@@ -281,7 +308,7 @@ class ContactControlNode:
             self._send(_ZERO, t)
         elif self._s.publish_when_idle:
             self._send(_ZERO, t)
-        self._was_active = result.move_active
+        self._was_active = result.commanding
 
     def _send(self, velocity: Sequence[float], t: float) -> None:
         """A twist already expressed in velocity_command_frame, for the wrench (or timer tick) at `t`."""
@@ -295,21 +322,33 @@ class ContactControlNode:
             self._twist_pub.publish(tw)
 
     # --- services ---
-    def _configure(self, req: Any) -> int | None:
+    def _configure(self, req: Any, validate: Callable[..., Any] = validate_request,
+                   service: str = "configure_cartesian_impedance") -> int | None:
         """Validates and applies a request (lock held); the new move id, or None when refused."""
         try:
-            laws = validate_request(req, self._limits)
+            laws = validate(req, self._limits)
             move_id = self._ctrl.set_laws(laws, None, rospy.get_time())
         except RequestError as err:
+            self._refusal = err
             self._request_note = f"last request refused (code {err.code}): {err.message}"
-            rospy.logwarn("configure_cartesian_impedance refused (error code %d): %s", err.code, err.message)
+            # The reason first: the original response type cannot carry it, the log and ~status must.
+            rospy.logwarn("%s [%s refused: %s (%d)]", err.message, service, CODE_NAMES.get(err.code, "?"),
+                          err.code)
             return None
         self._request_note = ""
         self._idle_zeros = int(self._s.idle_zero_count)
         self._move_ended.notify_all()  # a blocking caller of a replaced move answers now
-        active = ", ".join(f"{AXES[i]}={law.law}" for i, law in enumerate(laws) if law.law)
-        rospy.loginfo("contact laws set (move %d): %s", move_id, active or "none (all axes still)")
+        self._accepted = describe_laws(move_id, laws)
+        rospy.loginfo("%s", self._accepted)
         return move_id
+
+    def _on_configure_laws(self, req: Any) -> ConfigureLawsResponse:
+        """compliant_control_msgs/ConfigureLaws: per-axis laws; the answer carries the code and the reason."""
+        with self._lock:
+            if self._configure(req, validate_laws_request, "configure_laws") is None:
+                err = self._refusal
+                return ConfigureLawsResponse(success=False, code=err.code, message=err.message)
+            return ConfigureLawsResponse(success=True, code=SUCCESS, message=self._accepted)
 
     @staticmethod
     def _response(success: bool) -> ConfigureForceControlResponse:
@@ -379,6 +418,7 @@ class ContactControlNode:
         for i, axis in enumerate(msg.axes):
             axis.law, axis.end_condition = r.laws[i], r.end_conditions[i]
             axis.force, axis.velocity, axis.travel = w[i], v[i], r.travel[i]
+        fill_status_words(msg, r)
         self._status_pub.publish(msg)
 
     def _on_shutdown(self) -> None:
@@ -387,6 +427,32 @@ class ContactControlNode:
                 self._move_ended.notify_all()
                 with contextlib.suppress(rospy.ROSException):  # the publisher may already be closing
                     self._send(_ZERO, rospy.get_time())
+
+
+def describe_laws(move_id: int, laws: Sequence[Any]) -> str:
+    """The accepted laws in words, e.g. "contact laws set (move 3): z=compliant_move (v -0.01, move_away)".
+
+    A compliant move shows its velocity: it may be the default one, in the direction the node chose.
+    """
+    parts = []
+    for i, law in enumerate(laws):
+        if law.law:
+            notes = [f"v {law.velocity:g}"] if law.law == LAW_COMPLIANT_MOVE else []
+            if law.exceeded_action:
+                notes.append(EXCEEDED_ACTION_NAMES[law.exceeded_action])
+            parts.append(f"{AXES[i]}={LAW_NAMES[law.law]}" + (f" ({', '.join(notes)})" if notes else ""))
+    return f"contact laws set (move {move_id}): {', '.join(parts) or 'none (all axes still)'}"
+
+
+def fill_status_words(msg: Any, result: CycleResult) -> None:
+    """The names beside the codes of a ContactControlStatus (so `rostopic echo` reads in words)."""
+    msg.safety_name = SAFETY_NAMES.get(result.safety, str(result.safety))
+    msg.reacting = any(result.reacting)
+    for i, axis in enumerate(msg.axes):
+        axis.law_name = LAW_NAMES.get(result.laws[i], str(result.laws[i]))
+        axis.end_condition_name = END_NAMES.get(result.end_conditions[i], str(result.end_conditions[i]))
+        axis.exceeded_action = EXCEEDED_ACTION_NAMES.get(result.actions[i], "")
+        axis.reacting = result.reacting[i]
 
 
 def read_settings(param_ns: str = "~") -> ContactControlSettings | None:

@@ -83,6 +83,20 @@ PARAMETERS: dict[str, tuple[str, Any, str, str]] = {
     "compliant_slowdown_angle": ("nonneg", 0.02, "rad", "same for rotations"),
     "compliant_approach_speed_linear": ("pos", 0.02, "m/s", "slowest compliant move speed when slowing"),
     "compliant_approach_speed_angular": ("pos", 0.02, "rad/s", "same for rotations"),
+    "compliant_default_velocity_linear": (
+        "pos", 0.01, "m/s",
+        "V_desired of a compliant move requested without one, toward its force limit's sign",
+    ),
+    "compliant_default_velocity_angular": ("pos", 0.05, "rad/s", "same for rotations"),
+    # exceeded_action move_away (after a move ended on a force/torque limit)
+    "move_away_velocity_linear": ("pos", 0.01, "m/s", "speed of backing off along the contact force"),
+    "move_away_velocity_angular": ("pos", 0.05, "rad/s", "same for rotations"),
+    "move_away_release_fraction": (
+        "pos", 0.5, "",
+        "backing off ends once |F| is below this fraction of the axis's force/torque limit (hysteresis)",
+    ),
+    "move_away_max_distance": ("pos", 0.02, "m", "backing off ends after this distance at the latest"),
+    "move_away_max_angle": ("pos", 0.2, "rad", "same for rotations"),
     "diff_max_force": ("nonneg", 0.0, "N", "force change within diff_window that ends a move (0: off)"),
     "diff_max_torque": ("nonneg", 0.0, "Nm", "same for torques"),
     "diff_window": ("pos", 0.1, "s", "time window of the force-jump check"),
@@ -107,6 +121,9 @@ class AxisTuning:
     diff_max: float = 0.0
     spring_scale: float = 0.2
     spring_rounding: float = 0.01
+    default_velocity: float = 0.01
+    away_velocity: float = 0.01
+    away_max_travel: float = 0.02
 
 
 @dataclass(frozen=True)
@@ -164,6 +181,13 @@ class ContactControlSettings:
     compliant_slowdown_angle: float = 0.02
     compliant_approach_speed_linear: float = 0.02
     compliant_approach_speed_angular: float = 0.02
+    compliant_default_velocity_linear: float = 0.01
+    compliant_default_velocity_angular: float = 0.05
+    move_away_velocity_linear: float = 0.01
+    move_away_velocity_angular: float = 0.05
+    move_away_release_fraction: float = 0.5
+    move_away_max_distance: float = 0.02
+    move_away_max_angle: float = 0.2
     diff_max_force: float = 0.0
     diff_max_torque: float = 0.0
     diff_window: float = 0.1
@@ -198,6 +222,9 @@ class ContactControlSettings:
                 self.diff_max_torque,
                 self.spring_output_scale,
                 self.spring_rounding,
+                self.compliant_default_velocity_angular,
+                self.move_away_velocity_angular,
+                self.move_away_max_angle,
             )
         return AxisTuning(
             self.follower_deadband_force,
@@ -210,6 +237,9 @@ class ContactControlSettings:
             self.diff_max_force,
             self.spring_output_scale,
             self.spring_rounding,
+            self.compliant_default_velocity_linear,
+            self.move_away_velocity_linear,
+            self.move_away_max_distance,
         )
 
 
@@ -298,5 +328,14 @@ def _check_cross_constraints(s: ContactControlSettings) -> None:
         if t.approach_speed <= t.min_velocity:
             # Slower than min velocity would round to zero and stall the move before its max travel.
             raise ParamError(f"compliant_approach_speed_{suffix}", f"must exceed min_velocity_{suffix}")
+        for key, value in (
+            (f"compliant_default_velocity_{suffix}", t.default_velocity),
+            (f"move_away_velocity_{suffix}", t.away_velocity),
+        ):
+            # Not above the clamp (it would be cut anyway), above min velocity (it would never move).
+            if not t.min_velocity < value <= t.max_velocity:
+                raise ParamError(key, f"must exceed min_velocity_{suffix} and not exceed {t.max_velocity}")
+    if s.move_away_release_fraction >= 1.0:
+        raise ParamError("move_away_release_fraction", "must be below 1 (a fraction of the force limit)")
     if s.no_data_end_timeout and s.no_data_end_timeout < s.wrench_timeout:
         raise ParamError("no_data_end_timeout", "must be 0 or at least wrench_timeout")

@@ -26,10 +26,21 @@ from dataclasses import dataclass
 from types import SimpleNamespace
 from typing import Any
 
-from contact_control.axes import AXES, LAW_COMPLIANT_MOVE, LAW_FOLLOWER, LAW_NAMES, LAW_NONE, LAW_SPRING
+from contact_control.axes import (
+    AXES,
+    EXCEEDED_ACTION_NAMES,
+    EXCEEDED_GRAVITY_COMPENSATION,
+    EXCEEDED_STOP,
+    LAW_COMPLIANT_MOVE,
+    LAW_FOLLOWER,
+    LAW_NAMES,
+    LAW_NONE,
+    LAW_SPRING,
+)
 from contact_control.laws import AxisLaw
 
 __all__ = [
+    "CODE_NAMES",
     "FAILURE",
     "SET_CARTESIAN_CONTROL_FAILED",
     "SET_CONTROL_FORCE_FAILED",
@@ -39,8 +50,13 @@ __all__ = [
     "RequestError",
     "RequestLimits",
     "axis_groups",
+    "empty_laws_request",
     "empty_request",
+    "fill_laws_request",
     "fill_request",
+    "force_control_fields",
+    "laws_fields",
+    "validate_laws_request",
     "validate_request",
 ]
 
@@ -48,9 +64,17 @@ __all__ = [
 SUCCESS = 1
 FAILURE = 99999  # malformed request object, or the controller cannot take laws now (safety latched)
 SET_DOF_FAILED = -1  # unknown law type on an axis
-SET_CONTROL_FORCE_FAILED = -2  # force/torque limit NaN, negative, above the global limit; unsupported action
+SET_CONTROL_FORCE_FAILED = -2  # force/torque limit NaN, negative, above the global limit; exceeded action
 SET_FORCE_STIFFNESS_FAILED = -3  # spring stiffness k <= 0 or NaN
 SET_CARTESIAN_CONTROL_FAILED = -4  # damping, desired velocity or max travel invalid
+CODE_NAMES = {
+    SUCCESS: "SUCCESS",
+    FAILURE: "FAILURE",
+    SET_DOF_FAILED: "SET_DOF_FAILED",
+    SET_CONTROL_FORCE_FAILED: "SET_CONTROL_FORCE_FAILED",
+    SET_FORCE_STIFFNESS_FAILED: "SET_FORCE_STIFFNESS_FAILED",
+    SET_CARTESIAN_CONTROL_FAILED: "SET_CARTESIAN_CONTROL_FAILED",
+}
 
 
 class RequestError(ValueError):
@@ -65,12 +89,18 @@ class RequestError(ValueError):
 
 @dataclass(frozen=True)
 class RequestLimits:
-    """The node's ranges a request must respect (velocity range, force range); None: unchecked."""
+    """The node's ranges a request must respect (velocity range, force range); None: unchecked.
+
+    `default_velocity` / `default_angular_velocity` is the V_desired of a compliant move requested without one
+    (in the direction of its force limit's sign); None: such a request is refused.
+    """
 
     max_velocity: float | None = None  # [m/s] bound on |V_desired| of linear axes
     max_angular_velocity: float | None = None  # [rad/s]
     max_force: float | None = None  # [N] bound on force limits (the global limit trips first anyway)
     max_torque: float | None = None  # [Nm]
+    default_velocity: float | None = None  # [m/s]
+    default_angular_velocity: float | None = None  # [rad/s]
 
     @classmethod
     def from_settings(cls, settings: Any) -> RequestLimits:
@@ -80,6 +110,8 @@ class RequestLimits:
             settings.angular_velocity_limit,
             settings.global_max_force,
             settings.global_max_torque,
+            settings.compliant_default_velocity_linear,
+            settings.compliant_default_velocity_angular,
         )
 
 
@@ -107,6 +139,36 @@ def axis_groups(params: Any, axis: int) -> tuple[Any, Any, Any, Any, Any]:
     )
 
 
+def force_control_fields(axis: int) -> dict[str, str]:
+    """Where axis `axis` reads each value in a ConfigureForceControl request (for messages)."""
+    c = AXES[axis][-1]
+    lin = axis < 3
+    p = "cart_impedance_params"
+    return {
+        "law": f"direction_control_laws.{AXES[axis]}.type",
+        "b": f"{p}.damping.{'translational' if lin else 'rotational'}.{c}",
+        "k": f"{p}.stiffness.{'translational' if lin else 'rotational'}.{c}",
+        "v": f"{p}.max_cart_vel.set.{'linear' if lin else 'angular'}.{c}",
+        "limit": f"{p}.max_ctrl_force.set.{'force' if lin else 'torque'}.{c}",
+        "travel": f"{p}.max_path_deviation.{'translation' if lin else 'rotation'}.{c}",
+        "action": f"{p}.max_ctrl_force.exceeded_action",
+    }
+
+
+def laws_fields(axis: int) -> dict[str, str]:
+    """Where axis `axis` reads each value in a compliant_control_msgs/ConfigureLaws request."""
+    a = AXES[axis]
+    return {
+        "law": f"{a}.law",
+        "b": f"{a}.damping",
+        "k": f"{a}.stiffness",
+        "v": f"{a}.velocity",
+        "limit": f"{a}.force_limit",
+        "travel": f"{a}.max_travel",
+        "action": f"{a}.exceeded_action",
+    }
+
+
 def _fields(req: Any, axis: int) -> tuple[int, float, float, float, float, float]:
     c = AXES[axis][-1]
     groups = axis_groups(req.cart_impedance_params, axis)
@@ -116,57 +178,121 @@ def _fields(req: Any, axis: int) -> tuple[int, float, float, float, float, float
 
 
 def _axis_law(
-    axis: int, fields: tuple[int, float, float, float, float, float], limits: RequestLimits
+    axis: int,
+    fields: tuple[int, float, float, float, float, float],
+    limits: RequestLimits,
+    names: dict[str, str],
+    action: int = EXCEEDED_STOP,
 ) -> AxisLaw:
+    """One axis's law from its raw values, or a RequestError naming the field to set."""
     name = AXES[axis]
     law, b, k, v, limit, travel = fields
     angular = axis >= 3
     unit_f, unit_d, unit_v = ("Nm", "rad", "rad/s") if angular else ("N", "m", "m/s")
+    values = {"law": law, "b": b, "k": k, "v": v, "limit": limit, "travel": travel, "action": action}
 
-    def fail(code: int, what: str) -> RequestError:
-        return RequestError(code, f"axis {name} ({LAW_NAMES.get(law, law)}): {what}", name)
+    def fail(code: int, what: str, key: str) -> RequestError:
+        # The field to set and what it holds: "RX reads cart_impedance_params.damping.rotational.x; got 0.0"
+        where = f"{name.upper()} reads {names[key]}; got {values[key]}"
+        return RequestError(code, f"axis {name} ({LAW_NAMES.get(law, law)}): {what}; {where}", name)
 
     if law not in LAW_NAMES:
-        raise fail(SET_DOF_FAILED, f"unknown law type {law} (0 none, 1 follower, 2 spring, 3 compliant move)")
+        raise fail(SET_DOF_FAILED, f"unknown law type {law} (0 none, 1 follower, 2 spring, 3 compliant move)",
+                   "law")
     if law == LAW_NONE:
         return AxisLaw()
-    if not (limit >= 0.0 and math.isfinite(limit)):
-        raise fail(SET_CONTROL_FORCE_FAILED, f"force/torque limit must be finite, >= 0 {unit_f}; got {limit}")
+    signed_limit = law == LAW_COMPLIANT_MOVE and v == 0.0  # its sign gives the direction
+    if not ((limit >= 0.0 or signed_limit) and math.isfinite(limit)):
+        raise fail(SET_CONTROL_FORCE_FAILED, f"force/torque limit must be finite, >= 0 {unit_f}", "limit")
     cap = limits.max_torque if angular else limits.max_force
-    if cap is not None and limit > cap:
-        raise fail(SET_CONTROL_FORCE_FAILED, f"force/torque limit {limit} {unit_f} exceeds the global {cap}")
+    if cap is not None and abs(limit) > cap:
+        raise fail(SET_CONTROL_FORCE_FAILED, f"force/torque limit exceeds the global {cap} {unit_f}", "limit")
+    limit = abs(limit)
     if not (travel >= 0.0 and math.isfinite(travel)):
+        raise fail(SET_CARTESIAN_CONTROL_FAILED, f"max path deviation must be finite, >= 0 {unit_d}",
+                   "travel")
+    if action not in EXCEEDED_ACTION_NAMES:
         raise fail(
-            SET_CARTESIAN_CONTROL_FAILED, f"max path deviation must be finite, >= 0 {unit_d}; got {travel}"
+            SET_CONTROL_FORCE_FAILED,
+            "unknown exceeded action (0 stop, 1 move_away, 2 gravity_compensation)",
+            "action",
         )
+    if limit == 0.0:
+        action = EXCEEDED_STOP  # nothing to exceed
     if law in (LAW_FOLLOWER, LAW_SPRING) and not (b > 0.0 and math.isfinite(b)):
-        raise fail(SET_CARTESIAN_CONTROL_FAILED, f"damping b must be finite and > 0, got {b}")
+        raise fail(SET_CARTESIAN_CONTROL_FAILED, "damping b must be finite and > 0", "b")
     if law == LAW_SPRING:
         if not (k > 0.0 and math.isfinite(k)):
-            raise fail(SET_FORCE_STIFFNESS_FAILED, f"stiffness k must be finite and > 0, got {k}")
-        return AxisLaw(LAW_SPRING, damping=b, stiffness=k, force_limit=limit, max_travel=travel)
+            raise fail(SET_FORCE_STIFFNESS_FAILED, "stiffness k must be finite and > 0 (1/s)", "k")
+        return AxisLaw(
+            LAW_SPRING, damping=b, stiffness=k, force_limit=limit, max_travel=travel, exceeded_action=action
+        )
     if law == LAW_FOLLOWER:
-        return AxisLaw(LAW_FOLLOWER, damping=b, force_limit=limit, max_travel=travel)
+        return AxisLaw(LAW_FOLLOWER, damping=b, force_limit=limit, max_travel=travel, exceeded_action=action)
     # compliant move
     if not (b >= 0.0 and math.isfinite(b)):
+        raise fail(SET_CARTESIAN_CONTROL_FAILED, "damping b must be finite, >= 0 (0: no force term)", "b")
+    if action == EXCEEDED_GRAVITY_COMPENSATION and b == 0.0:
         raise fail(
-            SET_CARTESIAN_CONTROL_FAILED, f"damping b must be finite, >= 0 (0: no force term); got {b}"
+            SET_CARTESIAN_CONTROL_FAILED,
+            "gravity_compensation makes the axis a follower (V = F / b) after its force limit: "
+            "damping b must be > 0",
+            "b",
         )
-    if not (v != 0.0 and math.isfinite(v)):
-        raise fail(
-            SET_CARTESIAN_CONTROL_FAILED, f"desired velocity must be finite, non-zero {unit_v}; got {v}"
-        )
+    if not math.isfinite(v):
+        raise fail(SET_CARTESIAN_CONTROL_FAILED, f"desired velocity must be finite {unit_v}", "v")
+    if v == 0.0:
+        default = limits.default_angular_velocity if angular else limits.default_velocity
+        if limit == 0.0 or default is None:
+            raise fail(
+                SET_CARTESIAN_CONTROL_FAILED,
+                f"desired velocity must be non-zero {unit_v} (signed: the direction of the move)"
+                + (f", or give a signed force/torque limit in {names['limit']} to approach at the node's "
+                   f"compliant_default_velocity_{'angular' if angular else 'linear'} in its direction"
+                   if default is not None else ""),
+                "v",
+            )
+        v = math.copysign(default, fields[4])  # toward the force limit's sign
     vmax = limits.max_angular_velocity if angular else limits.max_velocity
     if vmax is not None and abs(v) > vmax:
-        raise fail(SET_CARTESIAN_CONTROL_FAILED, f"desired velocity {v} {unit_v} exceeds max velocity {vmax}")
+        raise fail(SET_CARTESIAN_CONTROL_FAILED, f"desired velocity exceeds max velocity {vmax} {unit_v}",
+                   "v")
     if travel == 0.0 and limit == 0.0:
         # It would run until something else stopped it: require at least one of its two end conditions.
-        raise fail(SET_CARTESIAN_CONTROL_FAILED, "needs a max path deviation > 0 or a force/torque limit > 0")
-    return AxisLaw(LAW_COMPLIANT_MOVE, damping=b, velocity=v, force_limit=limit, max_travel=travel)
+        raise fail(
+            SET_CARTESIAN_CONTROL_FAILED,
+            f"needs a max path deviation > 0 or a force/torque limit > 0 (or set {names['travel']})",
+            "limit",
+        )
+    return AxisLaw(
+        LAW_COMPLIANT_MOVE,
+        damping=b,
+        velocity=v,
+        force_limit=limit,
+        max_travel=travel,
+        exceeded_action=action,
+    )
+
+
+def _global_action(action: Any) -> int:
+    """The one exceeded action the original message's three flags select (all false: stop)."""
+    chosen = [name for name in ("stop", "gravity_compensation", "move_away") if getattr(action, name)]
+    if len(chosen) > 1:
+        raise RequestError(
+            SET_CONTROL_FORCE_FAILED,
+            "set at most one of cart_impedance_params.max_ctrl_force.exceeded_action."
+            f"{{stop, gravity_compensation, move_away}}; got {', '.join(chosen)}",
+        )
+    codes = {name: code for code, name in EXCEEDED_ACTION_NAMES.items()}
+    return codes[chosen[0]] if chosen else EXCEEDED_STOP
 
 
 def validate_request(req: Any, limits: RequestLimits | None = None) -> list[AxisLaw]:
     """Maps a ConfigureForceControl request to six `AxisLaw`s (x, y, z, rx, ry, rz), or refuses it.
+
+    The message's one `exceeded_action` applies to every axis with a force/torque limit > 0; axes without a
+    limit cannot exceed one. A compliant move without desired velocity approaches at
+    `limits.default_velocity` in the direction of its force limit's sign.
 
     Args:
         req: a ConfigureForceControlRequest, or anything with the same attribute tree (SimpleNamespace).
@@ -178,17 +304,47 @@ def validate_request(req: Any, limits: RequestLimits | None = None) -> list[Axis
     limits = limits or RequestLimits()
     try:
         action = req.cart_impedance_params.max_ctrl_force.exceeded_action
-        unsupported = [name for name in ("gravity_compensation", "move_away") if getattr(action, name)]
+        names = ("stop", "gravity_compensation", "move_away")
+        flags = SimpleNamespace(**{n: bool(getattr(action, n)) for n in names})
         raw = [_fields(req, axis) for axis in range(6)]
     except (AttributeError, TypeError, ValueError) as err:
         raise RequestError(FAILURE, f"malformed ConfigureForceControl request: {err}") from err
-    if unsupported:
-        raise RequestError(
-            SET_CONTROL_FORCE_FAILED,
-            f"exceeded_action {', '.join(unsupported)} is not supported; only stop (the move ends). "
-            "Tool gravity compensation is the node's tool_mass/tool_com parameters.",
-        )
-    return [_axis_law(axis, raw[axis], limits) for axis in range(6)]
+    code = _global_action(flags)
+    return [_axis_law(axis, raw[axis], limits, force_control_fields(axis), code) for axis in range(6)]
+
+
+def validate_laws_request(req: Any, limits: RequestLimits | None = None) -> list[AxisLaw]:
+    """Maps a compliant_control_msgs/ConfigureLaws request (fields x .. rz, AxisLaw messages) to six laws.
+
+    As `validate_request`, with a per-axis exceeded action; an exceeded action other than stop on an axis
+    without a force limit is refused (it could never act).
+
+    Raises:
+        RequestError: a CartesianForceCtrlErrorCodes code and a message naming the field (e.g. z.damping).
+    """
+    limits = limits or RequestLimits()
+    try:
+        raw = []
+        for name in AXES:
+            a = getattr(req, name)
+            numbers = (a.damping, a.stiffness, a.velocity, a.force_limit, a.max_travel)
+            values = (int(a.law), *(float(x) for x in numbers))
+            raw.append((values, int(a.exceeded_action)))
+    except (AttributeError, TypeError, ValueError) as err:
+        raise RequestError(FAILURE, f"malformed ConfigureLaws request: {err}") from err
+    laws = []
+    for axis, (values, action) in enumerate(raw):
+        law = _axis_law(axis, values, limits, laws_fields(axis), action)
+        if law.law and action != EXCEEDED_STOP and law.force_limit == 0.0:
+            name = AXES[axis]
+            raise RequestError(
+                SET_CONTROL_FORCE_FAILED,
+                f"axis {name} ({LAW_NAMES[law.law]}): exceeded_action {EXCEEDED_ACTION_NAMES[action]} acts "
+                f"when the force/torque limit is reached: set {name}.force_limit > 0; got 0.0",
+                name,
+            )
+        laws.append(law)
+    return laws
 
 
 def _vec3() -> SimpleNamespace:
@@ -217,7 +373,13 @@ def empty_request() -> SimpleNamespace:
 
 
 def fill_request(req: Any, laws: Sequence[AxisLaw]) -> Any:
-    """Writes six laws into a request (genpy message or `empty_request()`) and returns it; drops d_offset."""
+    """Writes six laws into a request (genpy message or `empty_request()`) and returns it; drops d_offset.
+
+    The exceeded_action flags get the laws' common action (stop when no axis has a force limit).
+
+    Raises:
+        ValueError: not six laws, or axes with force limits disagree on the exceeded action.
+    """
     if len(laws) != 6:
         raise ValueError(f"need 6 laws (x, y, z, rx, ry, rz), got {len(laws)}")
     p = req.cart_impedance_params
@@ -228,4 +390,34 @@ def fill_request(req: Any, laws: Sequence[AxisLaw]) -> Any:
         for group, value in zip(groups, values, strict=True):
             setattr(group, c, float(value))
         getattr(req.direction_control_laws, AXES[axis]).type = law.law
+    action = _common_action(laws)
+    flags = p.max_ctrl_force.exceeded_action
+    for code, name in EXCEEDED_ACTION_NAMES.items():
+        setattr(flags, name, code == action)
+    return req
+
+
+def _common_action(laws: Sequence[AxisLaw]) -> int:
+    """The one exceeded action of the laws with a force limit (the original message has only one)."""
+    actions = {law.exceeded_action for law in laws if law.law and law.force_limit > 0.0}
+    if len(actions) > 1:
+        raise ValueError("ConfigureForceControl has one exceeded_action for all axes; use ConfigureLaws")
+    return actions.pop() if actions else EXCEEDED_STOP
+
+
+def empty_laws_request() -> SimpleNamespace:
+    """A ConfigureLaws-shaped request of zeros (every axis NONE), for tests and Qt-free code."""
+    fields = ("law", "damping", "stiffness", "velocity", "force_limit", "max_travel", "exceeded_action")
+    return SimpleNamespace(**{name: SimpleNamespace(**dict.fromkeys(fields, 0)) for name in AXES})
+
+
+def fill_laws_request(req: Any, laws: Sequence[AxisLaw]) -> Any:
+    """Writes six laws into a ConfigureLaws request (genpy message or `empty_laws_request()`)."""
+    if len(laws) != 6:
+        raise ValueError(f"need 6 laws (x, y, z, rx, ry, rz), got {len(laws)}")
+    for name, law in zip(AXES, laws, strict=True):
+        a = getattr(req, name)
+        a.law, a.exceeded_action = law.law, law.exceeded_action
+        a.damping, a.stiffness, a.velocity = float(law.damping), float(law.stiffness), float(law.velocity)
+        a.force_limit, a.max_travel = float(law.force_limit), float(law.max_travel)
     return req

@@ -262,8 +262,9 @@ class JogArmNode:
                     message = f"{self._fault_note}; {message}"
                 else:
                     self._fault_note = ""
-            msg.code, msg.message, msg.condition_number, msg.speed_scale = (
+            msg.code, msg.code_name, msg.message, msg.condition_number, msg.speed_scale = (
                 int(status),
+                status.name,
                 message,
                 condition,
                 scale,

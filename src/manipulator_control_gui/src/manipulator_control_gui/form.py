@@ -13,8 +13,13 @@ max force/torque     p.max_ctrl_force.set.force.c          p.max_ctrl_force.set.
 max path deviation   p.max_path_deviation.translation.c    p.max_path_deviation.rotation.c
 ===================  ====================================  =====================================
 
-Fields the axis's law does not use are sent as 0. `max_ctrl_force.exceeded_action.stop` is always true:
-contact_control ends the move when a limit is reached and supports no other action.
+Fields the axis's law does not use are sent as 0. The form's one exceeded action (what happens when a max
+force/torque is reached: stop, move_away or gravity_compensation) sets that flag of
+`max_ctrl_force.exceeded_action`; contact_control applies it to every axis with a max force/torque.
+
+The same form maps to a compliant_control_msgs/ConfigureLaws request (`write_laws_request`), one AxisLaw per
+axis, the action on the axes with a max force/torque; the panel prefers that service when contact_control
+offers it, because its answer says why a request was refused.
 """
 
 from __future__ import annotations
@@ -36,9 +41,11 @@ from manipulator_control_gui.form_config import (
 )
 
 __all__ = [
+    "EXCEEDED_ACTIONS",
     "LAW_TYPES",
     "AxisForm",
     "FormError",
+    "build_laws_request",
     "build_request",
     "check_with_contact_control",
     "default_form",
@@ -49,11 +56,19 @@ __all__ = [
     "preset_form",
     "summarize_form",
     "validate_form",
+    "write_laws_request",
     "write_request",
 ]
 
 #: cartesian_impedance_msgs/ControlLaw TYPE_* of each law.
 LAW_TYPES: dict[str, int] = {"none": 0, "follower": 1, "spring": 2, "compliant_move": 3}
+#: What the axes with a max force/torque do when it is reached (compliant_control_msgs/AxisLaw ACTION_*), with
+#: the text of the panel's choice.
+EXCEEDED_ACTIONS: dict[str, tuple[int, str]] = {
+    "stop": (0, "stop (the whole move ends, every axis holds)"),
+    "move_away": (1, "move away from the contact, then hold"),
+    "gravity_compensation": (2, "gravity compensation (the axis follows the hand)"),
+}
 
 # cartesian_impedance_msgs/CartesianForceCtrlErrorCodes, with what contact_control means by each.
 _SUCCESS = 1
@@ -188,11 +203,26 @@ def validate_form(config: GuiConfig, form: Mapping[str, AxisForm]) -> None:
                 )
 
 
-def write_request(form: Mapping[str, AxisForm], req: Any) -> Any:
+def _check_action(action: str) -> None:
+    if action not in EXCEEDED_ACTIONS:
+        known = ", ".join(EXCEEDED_ACTIONS)
+        raise FormError(f"Unknown action on max force/torque '{action}'; known: {known}.")
+
+
+def write_request(form: Mapping[str, AxisForm], req: Any, action: str = "stop") -> Any:
     """Writes every axis of `form` into `req` (ConfigureForceControlRequest or same-shaped tree); returns it.
 
     Fields the axis's law does not use are written as 0, so nothing stale is sent.
+
+    Args:
+        form: the six rows.
+        req: the request to fill.
+        action: a key of EXCEEDED_ACTIONS; its flag of max_ctrl_force.exceeded_action is set, the others not.
+
+    Raises:
+        FormError: an unknown action.
     """
+    _check_action(action)
     p = req.cart_impedance_params
     for axis in AXES:
         row = form[axis]
@@ -203,13 +233,43 @@ def write_request(form: Mapping[str, AxisForm], req: Any) -> Any:
         for group, value in zip(groups, values, strict=True):
             setattr(group, component, float(value))
         getattr(req.direction_control_laws, axis).type = LAW_TYPES[row.law]
-    action = p.max_ctrl_force.exceeded_action
-    action.stop, action.gravity_compensation, action.move_away = True, False, False
+    flags = p.max_ctrl_force.exceeded_action
+    for name in EXCEEDED_ACTIONS:
+        setattr(flags, name, name == action)
     return req
 
 
-def check_with_contact_control(req: Any) -> bool:
+def write_laws_request(form: Mapping[str, AxisForm], req: Any, action: str = "stop") -> Any:
+    """Writes `form` into a ConfigureLaws request (or same-shaped tree: fields x .. rz); returns it.
+
+    Fields the axis's law does not use are written as 0; `action` goes to the axes with a max force/torque
+    (the others keep stop: they have nothing to exceed), as contact_control maps the original service's one
+    action.
+
+    Raises:
+        FormError: an unknown action.
+    """
+    _check_action(action)
+    code = EXCEEDED_ACTIONS[action][0]
+    for axis in AXES:
+        row, target = form[axis], getattr(req, axis)
+        used = LAW_FIELDS[row.law]
+        damping, stiffness, velocity, max_force, max_deviation = (
+            float(getattr(row, f)) if f in used else 0.0 for f in FIELDS
+        )
+        target.law = LAW_TYPES[row.law]
+        target.damping, target.stiffness, target.velocity = damping, stiffness, velocity
+        target.force_limit, target.max_travel = max_force, max_deviation
+        target.exceeded_action = code if row.law != "none" and max_force > 0.0 else 0
+    return req
+
+
+def check_with_contact_control(req: Any, laws: bool = False) -> bool:
     """Runs contact_control's own request validation (the node's check, without its velocity/force limits).
+
+    Args:
+        req: the request.
+        laws: it is a ConfigureLaws request (else ConfigureForceControl).
 
     Returns:
         True if the check ran, False if contact_control is not importable (then only the form was checked).
@@ -218,11 +278,11 @@ def check_with_contact_control(req: Any) -> bool:
         FormError: contact_control would refuse the request; `code` is its CartesianForceCtrlErrorCodes value.
     """
     try:
-        from contact_control.request import RequestError, validate_request
+        from contact_control.request import RequestError, validate_laws_request, validate_request
     except ImportError:
         return False
     try:
-        validate_request(req)
+        (validate_laws_request if laws else validate_request)(req)
     except RequestError as err:
         axis = getattr(err, "axis", "")
         raise FormError(
@@ -231,13 +291,16 @@ def check_with_contact_control(req: Any) -> bool:
     return True
 
 
-def build_request(config: GuiConfig, form: Mapping[str, AxisForm], req: Any = None) -> Any:
+def build_request(
+    config: GuiConfig, form: Mapping[str, AxisForm], req: Any = None, action: str = "stop"
+) -> Any:
     """Checks the form, maps it to a request and has contact_control check the request.
 
     Args:
         config: the form description (ranges).
         form: the six rows.
         req: the request object to fill; None for a new ConfigureForceControlRequest.
+        action: what the axes with a max force/torque do when it is reached (a key of EXCEEDED_ACTIONS).
 
     Raises:
         FormError: the form or the request is invalid; nothing should be sent.
@@ -247,8 +310,26 @@ def build_request(config: GuiConfig, form: Mapping[str, AxisForm], req: Any = No
         from cartesian_impedance_msgs.srv import ConfigureForceControlRequest
 
         req = ConfigureForceControlRequest()
-    write_request(form, req)
+    write_request(form, req, action)
     check_with_contact_control(req)
+    return req
+
+
+def build_laws_request(
+    config: GuiConfig, form: Mapping[str, AxisForm], req: Any = None, action: str = "stop"
+) -> Any:
+    """As `build_request`, for compliant_control_msgs/ConfigureLaws (None: a new ConfigureLawsRequest).
+
+    Raises:
+        FormError: the form or the request is invalid; nothing should be sent.
+    """
+    validate_form(config, form)
+    if req is None:
+        from compliant_control_msgs.srv import ConfigureLawsRequest
+
+        req = ConfigureLawsRequest()
+    write_laws_request(form, req, action)
+    check_with_contact_control(req, laws=True)
     return req
 
 

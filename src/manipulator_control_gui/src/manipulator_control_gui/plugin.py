@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from manipulator_control_gui.form import form_from_dict, form_to_dict
+from manipulator_control_gui.form import EXCEEDED_ACTIONS, form_from_dict, form_to_dict
 
 try:
     from qt_gui.plugin import Plugin
@@ -45,8 +45,12 @@ class ManipulatorControlPlugin(Plugin):
 
     def save_settings(self, plugin_settings, instance_settings) -> None:
         instance_settings.set_value("form", json.dumps(form_to_dict(self._widget.form())))
+        instance_settings.set_value("exceeded_action", self._widget.exceeded_action)
 
     def restore_settings(self, plugin_settings, instance_settings) -> None:
+        action = instance_settings.value("exceeded_action")
+        if action in EXCEEDED_ACTIONS:
+            self._widget.set_exceeded_action(action)
         saved = instance_settings.value("form")
         if not saved:
             return

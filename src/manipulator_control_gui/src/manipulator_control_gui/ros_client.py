@@ -23,17 +23,27 @@ class RosNames:
     stop_service: str = "contact_control_node/stop"
     reset_service: str = "contact_control_node/reset"
     status_topic: str = "contact_control_node/status"
+    #: compliant_control_msgs/ConfigureLaws, used instead of configure_service when registered (it answers
+    #: with the reason of a refusal).
+    laws_service: str = "configure_laws"
 
     @classmethod
     def from_params(cls, get_param: Callable[[str, Any], Any]) -> RosNames:
-        """Reads `~contact_control_node` (namespace of the node's private names) and per-name overrides."""
+        """Reads `~contact_control_node` (namespace of the node's private names) and per-name overrides.
+
+        `~configure_laws_service` defaults to `configure_laws` beside `~configure_service` (same namespace).
+        """
         node = str(get_param("~contact_control_node", "contact_control_node")).rstrip("/")
+        configure = str(get_param("~configure_service", cls.configure_service))
+        namespace, slash, _ = configure.rpartition("/")
+        laws = f"{namespace}{slash}{cls.laws_service}"
         return cls(
-            configure_service=str(get_param("~configure_service", cls.configure_service)),
+            configure_service=configure,
             tare_service=str(get_param("~tare_service", f"{node}/tare")),
             stop_service=str(get_param("~stop_service", f"{node}/stop")),
             reset_service=str(get_param("~reset_service", f"{node}/reset")),
             status_topic=str(get_param("~status_topic", f"{node}/status")),
+            laws_service=str(get_param("~configure_laws_service", laws)),
         )
 
 
@@ -44,9 +54,9 @@ class CallResult:
     Attributes:
         delivered: an answer arrived (False: the service was missing or the call failed in transport).
         success: the answer's `success`.
-        code: an error code if the answer carried one (the ConfigureForceControl reply's error message has
-            no field, so None there; None for Trigger services too).
-        message: the Trigger answer's message, or what went wrong in transport.
+        code: an error code if the answer carried one (ConfigureLaws does; the ConfigureForceControl reply's
+            error message has no field, so None there; None for Trigger services too).
+        message: the Trigger or ConfigureLaws answer's message, or what went wrong in transport.
     """
 
     delivered: bool
@@ -57,10 +67,12 @@ class CallResult:
 
 @dataclass(frozen=True)
 class Availability:
-    """Result of one look at the master: `master` reachable, and the services not registered."""
+    """Result of one look at the master: `master` reachable, the services not registered, and whether the
+    optional ConfigureLaws service is."""
 
     master: bool
     missing: tuple[str, ...]
+    laws: bool = False
 
     @property
     def ok(self) -> bool:
@@ -97,6 +109,7 @@ class ContactControlClient:
                     names.stop_service,
                     names.reset_service,
                     names.status_topic,
+                    names.laws_service,
                 )
             )
         )
@@ -144,9 +157,14 @@ class ContactControlClient:
                     master.lookupService(name)
                 except rosgraph.MasterError:
                     missing.append(name)
+            try:
+                master.lookupService(self.resolved.laws_service)
+                laws = True
+            except rosgraph.MasterError:
+                laws = False  # an older contact_control: the original service alone
         except OSError:
             return Availability(False, ())
-        return Availability(True, tuple(missing))
+        return Availability(True, tuple(missing), laws)
 
     def _watch(self) -> None:
         while not self._stop.is_set():
@@ -169,6 +187,15 @@ class ContactControlClient:
             return CallResult(True, bool(response.success), None if code is None else int(code))
 
         self._call(self.resolved.configure_service, ConfigureForceControl, request, answer, on_done)
+
+    def configure_laws(self, request: Any, on_done: Callable[[CallResult], None]) -> None:
+        """Sends a ConfigureLaws `request` in a worker thread; the result carries its code and message."""
+        from compliant_control_msgs.srv import ConfigureLaws
+
+        def answer(response: Any) -> CallResult:
+            return CallResult(True, bool(response.success), int(response.code), str(response.message))
+
+        self._call(self.resolved.laws_service, ConfigureLaws, request, answer, on_done)
 
     def trigger(self, which: str, on_done: Callable[[CallResult], None]) -> None:
         """Calls the std_srvs/Trigger service `which` ('stop', 'tare' or 'reset') in a worker thread."""

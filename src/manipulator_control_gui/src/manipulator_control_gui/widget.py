@@ -24,9 +24,11 @@ from python_qt_binding.QtWidgets import (
 )
 
 from manipulator_control_gui.form import (
+    EXCEEDED_ACTIONS,
     AxisForm,
     Form,
     FormError,
+    build_laws_request,
     build_request,
     describe_response,
     law_form,
@@ -143,6 +145,7 @@ class ControlWidget(QWidget):
         self._last_status_time: float | None = None
         self._filling = False
         self._awaiting_reason = False  # a refusal came back; its reason follows on the status topic
+        self._laws_service = False  # contact_control offers ConfigureLaws (answers with the reason)
         self._bridge = _Bridge(self)
         self._bridge.status.connect(self._show_status)
         self._bridge.availability.connect(self._show_availability)
@@ -197,16 +200,27 @@ class ControlWidget(QWidget):
             row.law_combo.currentIndexChanged.connect(lambda _i, a=axis: self._law_changed(a))
             row.show_fields()
             self.rows[axis] = row
-        note = QLabel(
-            "On max force/torque or max path deviation: stop (the whole move ends). 0 means no limit.",
-            laws_box,
+        limits_line = QHBoxLayout()
+        limits_line.addWidget(QLabel("On max force/torque:", laws_box))
+        self.action_combo = QComboBox(laws_box)
+        self.action_combo.setObjectName("exceeded_action_combo")
+        for action, (_code, text) in EXCEEDED_ACTIONS.items():
+            self.action_combo.addItem(text, action)
+        self.action_combo.setToolTip(
+            "What the axes with a max force/torque do when it is reached (exceeded_action)"
         )
-        grid.addWidget(note, len(AXES) + 1, 0, 1, len(headers))
+        limits_line.addWidget(self.action_combo)
+        path_note = "On max path deviation: the whole move ends. 0 means no limit."
+        limits_line.addWidget(QLabel(path_note, laws_box))
+        limits_line.addStretch(1)
+        grid.addLayout(limits_line, len(AXES) + 1, 0, 1, len(headers))
         layout.addWidget(laws_box)
 
         buttons = QHBoxLayout()
         self.apply_button = QPushButton("Apply", self)
-        self.apply_button.setToolTip("Send all six axes in one ConfigureForceControl request")
+        self.apply_button.setToolTip(
+            "Send all six axes in one request (ConfigureLaws when offered, else ConfigureForceControl)"
+        )
         self.stop_button = QPushButton("Stop", self)
         self.stop_button.setToolTip("End the move: every axis holds still")
         self.tare_button = QPushButton("Tare", self)
@@ -258,6 +272,15 @@ class ControlWidget(QWidget):
         """The form as currently filled in."""
         return {axis: row.row() for axis, row in self.rows.items()}
 
+    @property
+    def exceeded_action(self) -> str:
+        """The chosen action on max force/torque (a key of form.EXCEEDED_ACTIONS)."""
+        return str(self.action_combo.currentData())
+
+    def set_exceeded_action(self, action: str) -> None:
+        """Chooses the action on max force/torque (does not send anything)."""
+        self.action_combo.setCurrentIndex(self.action_combo.findData(action))
+
     def set_form(self, form: Form) -> None:
         """Fills the form (does not send it)."""
         self._filling = True
@@ -297,8 +320,10 @@ class ControlWidget(QWidget):
             True if a request was sent; False if the form was refused (the answer line says why).
         """
         form = self.form()
+        use_laws = self._laws_service
+        build = build_laws_request if use_laws else build_request
         try:
-            request = build_request(self.config, form)
+            request = build(self.config, form, action=self.exceeded_action)
         except FormError as err:
             self._answer(f"Not sent: {err.message}", _ERROR_STYLE)
             if err.axis in self.rows and err.field in self.rows[err.axis].spins:
@@ -306,7 +331,8 @@ class ControlWidget(QWidget):
             return False
         self._awaiting_reason = False
         self._answer(f"Sending: {summarize_form(self.config, form)} …", _BUSY_STYLE)
-        self.client.configure(request, lambda result: self._bridge.send("answer", "apply", result))
+        send = self.client.configure_laws if use_laws else self.client.configure
+        send(request, lambda result: self._bridge.send("answer", "apply", result))
         return True
 
     def _trigger(self, which: str) -> None:
@@ -329,8 +355,10 @@ class ControlWidget(QWidget):
             )
             return
         if which == "apply":
+            # ConfigureLaws answers with the code and the reason; the original service with neither, and the
+            # reason follows on the status topic.
             self._awaiting_reason = not result.success and result.code is None
-            text = describe_response(result.success, result.code)
+            text = describe_response(result.success, result.code, "" if result.success else result.message)
         else:
             verdict = "done" if result.success else "refused"
             text = f"{which.capitalize()} {verdict}" + (f": {result.message}" if result.message else ".")
@@ -344,10 +372,12 @@ class ControlWidget(QWidget):
             text = f"contact_control not available: {', '.join(availability.missing)} missing; {retry}."
             style = _ERROR_STYLE
         else:
+            via = f"; laws via {self.client.resolved.laws_service}" if availability.laws else ""
             text, style = (
-                f"Connected to contact_control ({self.client.resolved.configure_service}).",
+                f"Connected to contact_control ({self.client.resolved.configure_service}{via}).",
                 _OK_STYLE,
             )
+        self._laws_service = availability.ok and availability.laws
         self.connection_label.setText(text)
         self.connection_label.setStyleSheet(style)
 

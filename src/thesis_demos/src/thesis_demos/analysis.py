@@ -12,7 +12,7 @@ import numpy as np
 
 from thesis_demos.scenarios import Scenario
 
-__all__ = ["CONTACT_FORCE_BOUND", "Recording", "Verdict", "judge"]
+__all__ = ["CONTACT_FORCE_BOUND", "RESIDUAL_WINDOW", "Recording", "Verdict", "judge"]
 
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 # Compliant move stops on contact without pressing harder than this [N]. Why: the arm is a stiff
@@ -22,6 +22,9 @@ AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 # The bound must stay under contact_control's 25 N global limit, so that the move ends by its own law
 # and never by the safety latch; a cobot's own protective stop is far higher (around 150 N).
 CONTACT_FORCE_BOUND = 20.0
+# The residual contact force after a compliant move is the mean over this last part of the recording [s],
+# which runs `Scenario.settle` (1 s) past the end of the move and its backing off: sensor noise averages out.
+RESIDUAL_WINDOW = 0.5
 
 
 @dataclass
@@ -107,7 +110,16 @@ def _follower(scenario: Scenario, rec: Recording) -> Verdict:
     return Verdict(passed, summary, figures)
 
 
+def _residual_force(rec: Recording, window: float = RESIDUAL_WINDOW) -> float:
+    """Mean |contact force| along Z [N] over the recording's last `window` seconds: what still presses."""
+    if not rec.wrench_t.size:
+        return float("nan")
+    tail = rec.wrench_t >= rec.wrench_t[-1] - window
+    return float(abs(np.mean(rec.contact_force[tail, 2])))
+
+
 def _compliant(scenario: Scenario, rec: Recording) -> Verdict:
+    limit = scenario.laws["z"].force_limit
     start = rec.pose[0]
     end = rec.pose[-1]
     travel = float(start[2] - end[2])
@@ -115,17 +127,23 @@ def _compliant(scenario: Scenario, rec: Recording) -> Verdict:
     peak = _max(np.abs(rec.contact_force[:, 2]))
     tail = _window(rec.pose_t, rec.pose_t[-1] - 0.8, rec.pose_t[-1])
     hold = float(np.ptp(rec.pose[tail, 2])) if np.any(tail) else float("nan")
+    residual = _residual_force(rec)
     figures = {
         "travel down [mm]": travel * 1e3,
         "peak contact force [N]": peak,
         "contact force bound [N]": CONTACT_FORCE_BOUND,
         "motion while holding [mm]": hold * 1e3,
+        "residual contact force [N]": residual,
+        "force limit [N]": limit,
     }
     passed = travel > 0.02 and ended_by_force and peak < CONTACT_FORCE_BOUND and hold < 1e-3
+    if scenario.exceeded_action == "move_away":
+        passed = passed and residual < limit  # no standing press on the obstacle
     reason = "force limit" if ended_by_force else f"end condition {rec.end_conditions.get('z')}"
     summary = (
         f"moved {travel * 1e3:.1f} mm down, stopped by {reason}, peak contact force {peak:.2f} N "
-        f"(bound {CONTACT_FORCE_BOUND:.0f} N), then held within {hold * 1e3:.2f} mm"
+        f"(bound {CONTACT_FORCE_BOUND:.0f} N), {scenario.exceeded_action.replace('_', ' ')}: "
+        f"residual contact force {residual:.2f} N (limit {limit:g} N), then held within {hold * 1e3:.2f} mm"
     )
     return Verdict(passed, summary, figures)
 

@@ -62,7 +62,10 @@ def build_request(scenario: Scenario) -> ConfigureForceControlRequest:
             c,
             law.max_travel,
         )
-    p.max_ctrl_force.exceeded_action.stop = True
+    action = p.max_ctrl_force.exceeded_action
+    if scenario.exceeded_action not in ("stop", "move_away", "gravity_compensation"):
+        raise ValueError(f"{scenario.name}: unknown exceeded_action {scenario.exceeded_action!r}")
+    setattr(action, scenario.exceeded_action, True)
     return req
 
 
@@ -191,10 +194,11 @@ class DemoRunner:
         self._wait(still, timeout, "the arm to settle")
 
     def _move_state(self) -> tuple[bool, dict[str, int]]:
+        """(whether the move or its exceeded action, e.g. moving away, still runs; end condition per axis)."""
         with self._status_lock:
             status = self._last_status
         ends = {a.axis: a.end_condition for a in status.axes} if status else {}
-        return bool(status and status.move_active), ends
+        return bool(status and (status.move_active or status.reacting)), ends
 
     # --- one scenario ---
     def run(self, scenario: Scenario, sensor_frame: str) -> Recording:

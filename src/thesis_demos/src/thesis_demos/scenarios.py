@@ -52,12 +52,17 @@ class Scenario:
     end_when_move_ends: bool = False  # stop recording early (after `settle`) once the move has ended
     settle: float = 1.0  # [s]
     controlled: tuple[str, ...] = field(default_factory=tuple)
+    # max_ctrl_force.exceeded_action of the request (one for all axes with a force limit): stop, move_away or
+    # gravity_compensation.
+    exceeded_action: str = "stop"
 
 
 # Thesis section 6.4, with the numbers it gives. Where it is silent: pushes of 5 N (follower) and
 # 15 N (spring), V_desired -0.01 m/s (down, onto the obstacle: a usual approach speed for contact,
 # and the contact force grows with it) and -0.05 m/s (X, toward the robot
-# base, where both robots have 0.30 m of clear travel).
+# base, where both robots have 0.30 m of clear travel). The compliant move backs off from the obstacle once
+# it stops (exceeded_action move_away): a position-controlled arm that stopped on contact otherwise keeps
+# pressing on it with what it overshot (up to 9 N on a simulated arm).
 SCENARIOS: tuple[Scenario, ...] = (
     Scenario(
         name="follower_z",
@@ -69,7 +74,7 @@ SCENARIOS: tuple[Scenario, ...] = (
     ),
     Scenario(
         name="compliant_move_z",
-        title="Compliant move on Z toward an obstacle (max force 0.5 N, max torque 0.5 Nm)",
+        title="Compliant move on Z toward an obstacle (max force 0.5 N, max torque 0.5 Nm), then move away",
         laws={
             "z": AxisLaw(
                 COMPLIANT_MOVE,
@@ -83,6 +88,7 @@ SCENARIOS: tuple[Scenario, ...] = (
         duration=11.0,
         end_when_move_ends=True,
         controlled=("z",),
+        exceeded_action="move_away",
     ),
     Scenario(
         name="spring_x",
