@@ -490,3 +490,29 @@ def test_configure_laws_answers_with_the_reason_and_a_refusal_changes_nothing(fr
     assert not response.success and "set x.force_limit > 0" in response.message
     status = latest_status(node, lambda s: "refused" in s.message, "the refusal in ~status")
     assert status.move_active and status.axes[2].law_name == "follower"
+
+
+def test_wrench_stamped_in_the_future_gives_zero_twist_and_a_reason_then_resumes(fresh):
+    """A sensor on another clock (or data from before a backward clock jump) is refused like NaN."""
+    import rospy
+
+    node = fresh
+    assert "success: True" in rosservice(readme_command())
+    wait_twist(node, lambda t: t[2] == pytest.approx(0.2), [0, 0, 6.0, 0, 0, 0], "the follower to follow")
+    msg = WrenchStamped()
+    msg.header.frame_id = "ft_sensor"
+    msg.wrench.force.x, msg.wrench.force.y, msg.wrench.force.z = sensor_wrench([0, 0, 6.0, 0, 0, 0])[:3]
+
+    def ahead() -> bool:
+        msg.header.stamp = rospy.Time.now() + rospy.Duration(5.0)
+        node.pub.publish(msg)
+        return any(twist_of(m) == [0.0] * 6 for m in list(node.twists.msgs)[-3:]) and any(
+            "ahead" in s.message and s.safety == ContactControlStatus.SAFETY_NAN
+            for s in list(node.status.msgs)
+        )
+
+    node.twists.clear()
+    node.status.clear()
+    wait_until(ahead, 10, "a zero twist and the reason for a wrench stamped 5 s ahead")
+    assert node.status.last().move_active
+    wait_twist(node, lambda t: t[2] == pytest.approx(0.2), [0, 0, 6.0, 0, 0, 0], "following again")

@@ -201,3 +201,64 @@ def test_a_roscore_restart_stops_the_arm_and_the_stack_comes_back_by_itself(ros_
             watch.close()
             for c in (cc_status, jog_status, pose):
                 c.close()
+
+
+def test_a_request_re_sent_at_100_hz_during_a_push_does_not_change_the_motion(ros_node):
+    """A GUI's Apply held down, a script in a loop: the same follower request 100 times a second while a
+    5 N push lasts. Each used to restart the axes from rest (0.7 mm instead of 21 mm); now nothing changes."""
+    import threading
+
+    rospy = ros_node
+    with run_launch("ur5_custom", "sim.launch") as h:
+        _stack(h)
+        h.wait_for_service("/mujoco_driver/push", timeout=40)
+        pose = Collector("/mujoco_driver/eef_pose", PoseStamped)
+        joints = Collector("/joint_states", JointState)
+        req = ConfigureForceControlRequest()
+        req.cart_impedance_params.damping.translational.z = 30.0  # the thesis's b: 5 N -> 0.17 m/s
+        req.direction_control_laws.z.type = ControlLaw.TYPE_FOLLOWER
+        configure = rospy.ServiceProxy(
+            "/configure_cartesian_impedance", ConfigureForceControl, persistent=True
+        )
+        push_srv = rospy.ServiceProxy("/mujoco_driver/push", PushEEF)
+        try:
+            pose.wait_for(1, 20)
+            joints.wait_for(1, 20)
+            assert configure(req).success
+
+            def pushed(fz: float, spam: bool) -> tuple[float, int]:
+                """Z travel [m] under a 0.4 s push of `fz` N, and how many requests were re-sent meanwhile"""
+                wait_until(lambda: _stopped(joints), 10, "the arm at rest")
+                z0 = _tip(pose)[2]
+                stop, sent = threading.Event(), [0]
+
+                def resend() -> None:
+                    while not stop.wait(0.01):
+                        assert configure(req).success
+                        sent[0] += 1
+
+                thread = threading.Thread(target=resend, daemon=True)
+                if spam:
+                    thread.start()
+                push = PushEEFRequest(duration=0.4)
+                push.wrench.force.z = fz
+                assert push_srv(push).success
+                wait_until(lambda: not _stopped(joints), 5, "the push to move the arm")
+                wait_until(lambda: _stopped(joints), 10, "the arm to stop after the push")
+                stop.set()
+                if spam:
+                    thread.join()
+                return _tip(pose)[2] - z0, sent[0]
+
+            quiet, _ = pushed(5.0, spam=False)
+            pushed(-5.0, spam=False)  # back down
+            spammed, sent = pushed(5.0, spam=True)
+            print(f"\nfollower under a 5 N push: {quiet * 1e3:.1f} mm; with the request re-sent {sent} times "
+                  f"meanwhile: {spammed * 1e3:.1f} mm")
+            assert quiet > 0.01
+            assert sent >= 20
+            assert spammed == pytest.approx(quiet, rel=0.10)
+        finally:
+            configure.close()
+            pose.close()
+            joints.close()
