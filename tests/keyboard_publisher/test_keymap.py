@@ -80,6 +80,33 @@ def test_held_key_repeats_keep_moving_past_the_timeout():
     assert not teleop.press("w", 2.0).publish_now  # a repeat is not a new command
 
 
+def test_a_released_held_key_stops_after_repeat_timeout_not_key_timeout():
+    """A real hold: first press, the terminal's 0.5 s repeat delay, then repeats at 30 Hz for 1.5 s."""
+    teleop = state(key_timeout=0.6, repeat_timeout=0.15)
+    presses = [0.0] + [0.5 + n / 30.0 for n in range(46)]
+    for t in presses:
+        teleop.press("w", t)
+    last = presses[-1]
+    # Moving all along: the first gap (the repeat delay) is bridged by key_timeout ...
+    assert all(teleop.command(t)[0] == pytest.approx(0.2) for t in (0.3, 0.49, 1.0, last + 0.14))
+    # ... and after the release the twist stops 0.15 s after the last repeat: 30 mm at 0.2 m/s, not 120.
+    assert teleop.command(last + 0.151) == ZERO
+
+
+def test_a_single_tap_moves_for_key_timeout():
+    teleop = state(key_timeout=0.6, repeat_timeout=0.15)
+    teleop.press("w", 0.0)
+    assert teleop.command(0.59)[0] == pytest.approx(0.2)
+    assert teleop.command(0.6) == ZERO
+    teleop.press("w", 1.0)  # a new tap after the stop is a first press again: key_timeout
+    assert teleop.command(1.5)[0] == pytest.approx(0.2)
+
+
+def test_repeat_timeout_above_key_timeout_is_refused():
+    with pytest.raises(SettingsError, match="repeat_timeout"):
+        TeleopSettings(key_timeout=0.3, repeat_timeout=0.5)
+
+
 def test_new_motion_key_replaces_the_command():
     teleop = state()
     teleop.press("w", 0.0)

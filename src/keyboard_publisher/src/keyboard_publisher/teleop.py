@@ -5,6 +5,11 @@ delay of about 0.5 s, then about 30 per second). So motion is a deadman: the lat
 whole twist (one axis at a time, like the original), and the twist stays until `key_timeout` passes without
 a motion key; then zero is sent `stop_repeats` times and publishing goes quiet, so that other sources on the
 same topic (contact_control) are not overridden by a stream of zeros. The stop key sends zero at once.
+
+Overrun: `key_timeout` must bridge the repeat delay, but only once. When a second press of the same key
+arrives while it moves (the terminal's auto-repeat), the deadman shortens to `repeat_timeout`, so releasing a
+held key stops the twist within `repeat_timeout` (a few repeat periods), not `key_timeout`. A single tap
+moves for `key_timeout`: a tap and the start of a hold look alike until the first repeat.
 """
 
 from __future__ import annotations
@@ -49,6 +54,7 @@ PARAMETERS: dict[str, tuple[Any, str, str]] = {
     "speed_step": (1.1, "", "factor (> 1) one speed key press multiplies or divides the speed by"),
     "rate": (50.0, "Hz", "publish rate while moving"),
     "key_timeout": (0.6, "s", "deadman: zero when no motion key came for this long (> the repeat delay)"),
+    "repeat_timeout": (0.15, "s", "deadman once the key auto-repeats (> a few repeat periods, ~33 ms each)"),
     "stop_repeats": (3, "", "zero twists sent after a stop or a timeout, then silence"),
 }
 
@@ -75,6 +81,7 @@ class TeleopSettings:
     speed_step: float = PARAMETERS["speed_step"][0]
     rate: float = PARAMETERS["rate"][0]
     key_timeout: float = PARAMETERS["key_timeout"][0]
+    repeat_timeout: float = PARAMETERS["repeat_timeout"][0]
     stop_repeats: int = PARAMETERS["stop_repeats"][0]
 
     def __post_init__(self) -> None:
@@ -86,8 +93,13 @@ class TeleopSettings:
             raise SettingsError("frame_id", f"must be a string, got {self.frame_id!r}")
         for name in (
             "linear_speed", "max_linear_speed", "angular_speed", "max_angular_speed", "rate", "key_timeout",
+            "repeat_timeout",
         ):
             _positive(name, getattr(self, name))
+        if self.repeat_timeout > self.key_timeout:
+            raise SettingsError(
+                "repeat_timeout", f"{self.repeat_timeout} s exceeds ~key_timeout ({self.key_timeout} s)"
+            )
         _positive("speed_step", self.speed_step)
         if not self.speed_step > 1.0:
             raise SettingsError("speed_step", f"must be > 1 (a factor), got {self.speed_step}")
@@ -172,6 +184,7 @@ class TeleopState:
         self._zeros_left = 0
         self._held: str | None = None
         self._held_time = 0.0
+        self._repeating = False  # the motion key has auto-repeated since it was first pressed
 
     @property
     def settings(self) -> TeleopSettings:
@@ -197,6 +210,7 @@ class TeleopState:
             return KeyResult(None, False, False, released)
         if binding.action is Action.MOTION:
             publish_now = binding != self._motion or self._expired(now)
+            self._repeating = not publish_now  # the same key again while it moves: the terminal repeats it
             self._motion, self._motion_time = binding, now
             self._update_command()
             return KeyResult(binding, publish_now, False, released)
@@ -231,10 +245,12 @@ class TeleopState:
         return None
 
     def _expired(self, now: float) -> bool:
-        return now - self._motion_time >= self._settings.key_timeout
+        s = self._settings
+        return now - self._motion_time >= (s.repeat_timeout if self._repeating else s.key_timeout)
 
     def _stop(self) -> None:
         self._motion = None
+        self._repeating = False
         self._command = ZERO
         self._zeros_left = self._settings.stop_repeats
 
