@@ -45,6 +45,7 @@ from contact_control.exceeded import ExceededReaction
 from contact_control.laws import AxisLaw, ForceWindow, check_end, law_velocity, shape_velocity
 from contact_control.params import ContactControlSettings
 from contact_control.preprocess import PreprocessError, WrenchPreprocessor, is_finite6
+from contact_control.rate import SamplePeriod
 from contact_control.request import FAILURE, RequestError
 from contact_control.travel import TravelMeter
 
@@ -169,6 +170,9 @@ class ContactControl:
         self.preprocessor = WrenchPreprocessor(s)
         self._tuning = tuple(s.tuning(i >= 3) for i in range(6))
         self._timeout = s.wrench_timeout
+        self._rate = SamplePeriod()
+        self._adapt_filter = s.lp_filter_rate_adapt and s.lp_filter_enabled
+        self.notes: list[str] = []  # what the node should log once (the sensor's measured rate, ...)
         self._end_timeout = s.no_data_end_timeout
         self._check_age = s.check_stamp_age
         self._future = s.future_stamp_tolerance
@@ -340,12 +344,39 @@ class ContactControl:
         self._end_message = ""
         return self._move_id
 
+    @property
+    def sample_period(self) -> float | None:
+        """The sensor's measured sample period [s] (None until measured)."""
+        return self._rate.period
+
+    @property
+    def wrench_timeout(self) -> float:
+        """The stale timeout in use [s]: wrench_timeout, or wrench_timeout_periods periods if longer."""
+        return self._timeout
+
+    def _on_sample_period(self, period: float) -> None:
+        """Keeps the filter's cutoff (in Hz) and the stale timeout true to the sensor's measured rate."""
+        s = self.settings
+        if s.wrench_timeout_periods > 0.0:
+            self._timeout = max(s.wrench_timeout, s.wrench_timeout_periods * period)
+        pre = self.preprocessor
+        if self._adapt_filter and abs(period - pre.design_period) > 0.1 * pre.design_period:
+            cutoff = pre.redesign_filter(period)
+            rate = 1.0 / period
+            note = f"low-pass filter designed for the measured {rate:.4g} Hz wrench (cutoff {cutoff:.3g}"
+            configured = s.lp_filter_delta_t
+            if abs(period - configured) > 0.2 * configured:
+                note += f" Hz; lp_filter_delta_t says {configured} s, {1.0 / configured:.4g}"
+            note += " Hz"
+            self.notes.append(f"{note}); stale after {self._timeout:.3g} s")
+
     def clock_jumped(self, t: float, description: str) -> CycleResult:
         """The clock jumped (see compliant_common.clock): every duration measured across it is wrong, so the
         output halts and the timing restarts at `t` (no wrench counts as received, the no-data end timeout and
         force-limit arming restart); the move resumes with the next wrench stamped after the jump."""
         self._last_rx = None
         self._last_t = None
+        self._rate.reset()
         if self._move_active:
             self._move_t0 = t
         for window in self._windows:
@@ -402,6 +433,8 @@ class ContactControl:
             R_fixed_control: control frame orientation at the move's start, used if the start is taken now.
             stamp: the wrench's header time [s] or None; older than wrench_timeout counts as no data.
         """
+        if self._rate.add(t if stamp is None else stamp):
+            self._on_sample_period(self._rate.period)  # type: ignore[arg-type]
         if stamp is not None and self._check_age:
             if t - stamp > self._timeout:
                 age = f"wrench stamp is {t - stamp:.3f} s old (wrench_timeout {self._timeout} s)"

@@ -62,6 +62,11 @@ class LowPass:
         self._y2 = [0.0] * channels
         self._primed = False
 
+    @property
+    def last(self) -> list[float] | None:
+        """The last outputs (a copy), None before the first sample."""
+        return list(self._y1) if self._primed else None
+
     def reset(self, values: Sequence[float] | None = None) -> None:
         """Forgets the history; the next step starts in steady state at its input (or at `values`)."""
         if values is None:

@@ -242,6 +242,10 @@ class ContactControlNode:
                 self._publish(self._ctrl.hold(t, SAFETY_NO_TF, f"no transform: {err}"), t)
             else:
                 self._publish(self._ctrl.update(wrench, t, T_cs, R_ws, eef, R_fc, stamp), t, R_cc)
+                if self._ctrl.notes:  # the sensor's measured rate, once per change
+                    for note in self._ctrl.notes:
+                        rospy.logwarn("contact_control: %s", note)
+                    self._ctrl.notes.clear()
                 if self._frame_source is not None:  # the model caches poses per joint state: fill it now,
                     with contextlib.suppress(*_TF_ERRORS, LookupError):  # off the wrench-to-twist path
                         self._frames(sensor_frame, self._ctrl.needs_travel)

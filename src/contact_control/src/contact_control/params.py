@@ -38,6 +38,9 @@ PARAMETERS: dict[str, tuple[str, Any, str, str]] = {
     "control_rate": ("pos", 500.0, "Hz", "stale-check and hold timer rate; nominal cycle for rate limits"),
     "status_rate": ("pos", 50.0, "Hz", "~status publish rate"),
     "wrench_timeout": ("pos", 0.1, "s", "no wrench for longer: output zero (SAFETY_STALE)"),
+    "wrench_timeout_periods": (
+        "nonneg", 10.0, "", "the stale timeout is at least this many measured sample periods (0: fixed)",
+    ),
     "no_data_end_timeout": ("nonneg", 1.0, "s", "stale for longer: the move ends with NO_FT_DATA"),
     "check_stamp_age": ("bool", True, "", "wrenches stamped more than wrench_timeout ago are stale"),
     "future_stamp_tolerance": (
@@ -48,8 +51,11 @@ PARAMETERS: dict[str, tuple[str, Any, str, str]] = {
     "publish_synchronously": ("bool", True, "", "send the twist from the wrench callback, no sender thread"),
     # wrench preprocessing
     "lp_filter_enabled": ("bool", True, "", "second-order Butterworth low-pass on the wrench"),
-    "lp_filter_delta_t": ("pos", 0.2, "s", "design sample period (the filter steps once per wrench)"),
-    "lp_filter_cutoff_freq": ("pos", 0.6, "Hz", "cutoff at that sample period"),
+    "lp_filter_delta_t": ("pos", 0.002, "s", "expected sample period: the design until the rate is measured"),
+    "lp_filter_cutoff_freq": ("pos", 5.0, "Hz", "cutoff (true at the measured rate: lp_filter_rate_adapt)"),
+    "lp_filter_rate_adapt": (
+        "bool", True, "", "design the filter for the measured sample period (lp_filter_delta_t until known)",
+    ),
     "ft_x_direction": ("sign", 1, "", "legacy sign flip of sensor force X and torque X (prefer tf frames)"),
     "ft_y_direction": ("sign", 1, "", "legacy sign flip of sensor force Y and torque Y"),
     "ft_z_direction": ("sign", 1, "", "legacy sign flip of sensor force Z and torque Z"),
@@ -141,6 +147,7 @@ class ContactControlSettings:
     control_rate: float = 500.0
     status_rate: float = 50.0
     wrench_timeout: float = 0.1
+    wrench_timeout_periods: float = 10.0
     no_data_end_timeout: float = 1.0
     check_stamp_age: bool = True
     future_stamp_tolerance: float = 0.1
@@ -148,8 +155,9 @@ class ContactControlSettings:
     idle_zero_count: float = 10.0
     publish_synchronously: bool = True
     lp_filter_enabled: bool = True
-    lp_filter_delta_t: float = 0.2
-    lp_filter_cutoff_freq: float = 0.6
+    lp_filter_delta_t: float = 0.002
+    lp_filter_cutoff_freq: float = 5.0
+    lp_filter_rate_adapt: bool = True
     ft_x_direction: int = 1
     ft_y_direction: int = 1
     ft_z_direction: int = 1

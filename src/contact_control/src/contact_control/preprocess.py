@@ -50,6 +50,8 @@ class WrenchPreprocessor:
         self.set_limits(settings.global_max_force, settings.global_max_torque)
         self.set_deadband(settings.force_deadband, settings.torque_deadband)
         self._filter: LowPass | None = None
+        self._cutoff = settings.lp_filter_cutoff_freq
+        self.design_period = settings.lp_filter_delta_t  # [s] the filter's current design sample period
         if settings.lp_filter_enabled:
             self.set_filter(True, settings.lp_filter_delta_t, settings.lp_filter_cutoff_freq)
 
@@ -90,6 +92,21 @@ class WrenchPreprocessor:
             self._filter = LowPass(delta_t, cutoff_freq, 6)
         except ValueError as err:
             raise PreprocessError(str(err)) from err
+        self._cutoff, self.design_period = cutoff_freq, delta_t
+
+    def redesign_filter(self, period: float) -> float | None:
+        """Designs the filter anew for samples `period` [s] apart, keeping its cutoff in Hz (below 0.45 of the
+        sample rate: closer to Nyquist the bilinear design degenerates); continues from its last output, so
+        the change makes no step. Returns the cutoff used, None without a filter."""
+        old = self._filter
+        if old is None:
+            return None
+        cutoff = min(self._cutoff, 0.45 / period)
+        new = LowPass(period, cutoff, 6)
+        if old.last is not None:
+            new.reset(old.last)
+        self._filter, self.design_period = new, period
+        return cutoff
 
     # --- tool gravity and tare ---
     def gravity_wrench(self, R_world_sensor: Any) -> list[float]:
