@@ -117,3 +117,17 @@ def test_a_request_with_a_different_law_everywhere_still_starts_from_rest():
     move = AxisLaw(LAW_COMPLIANT_MOVE, damping=0.0, velocity=0.05)
     ctrl.set_laws(laws(z=move), None, loop.t)
     assert loop.run(PUSH_Z, DT).velocity[2] < 0.01
+
+
+def test_a_law_set_before_the_sim_clock_runs_waits_for_data_instead_of_ending():
+    """`rosbag play --clock` with use_sim_time: the law is set while the clock still reads 0; when the bag's
+    clock appears (1.7e9 s) the move must not end at once for "no data since the start"."""
+    ctrl = controller(lp_filter_enabled=False, wrench_timeout=0.1, no_data_end_timeout=1.0)
+    ctrl.set_laws(laws(z=FOLLOWER), np.eye(4), 0.0)
+    t0 = 1.7e9
+    held = ctrl.check_stale(t0)
+    assert held.velocity == [0.0] * 6 and ctrl.move_active
+    assert ctrl.check_stale(t0 + 0.5) is not None and ctrl.move_active  # still waiting, within the timeout
+    for k in range(300):
+        ctrl.update(PUSH_Z, t0 + 0.6 + k * DT, stamp=t0 + 0.6 + k * DT)
+    assert ctrl.last_result.velocity[2] > 0.1 and ctrl.move_active

@@ -504,6 +504,10 @@ class ContactControl:
         last = self._last_rx
         if last is not None and t - last <= self._timeout:
             return None
+        if self._move_active and not self._move_t0 and t > 0.0:
+            # Set under sim time before the clock ran (a law set before `rosbag play --clock`): the move's
+            # wait for data starts with the clock, or it would end the moment the bag's clock appears.
+            self._move_t0 = t
         if self._move_active:
             since = last if last is not None else self._move_t0
             if self._move_t0 is not None and (since is None or since < self._move_t0):

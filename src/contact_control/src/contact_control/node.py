@@ -234,7 +234,8 @@ class ContactControlNode:
         f, q = msg.wrench.force, msg.wrench.torque
         wrench = (f.x, f.y, f.z, q.x, q.y, q.z)
         stamp = msg.header.stamp.to_sec() if not msg.header.stamp.is_zero() else None
-        sensor_frame = msg.header.frame_id or self._s.ft_sensor_frame
+        header_frame = "" if self._s.use_ft_sensor_frame else msg.header.frame_id
+        sensor_frame = header_frame or self._s.ft_sensor_frame
         with self._lock:
             try:
                 T_cs, R_ws, eef, R_fc, R_cc = self._frames(sensor_frame, self._ctrl.needs_travel)

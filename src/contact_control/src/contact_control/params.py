@@ -32,6 +32,9 @@ PARAMETERS: dict[str, tuple[str, Any, str, str]] = {
     "fixed_frame": ("str", "base_link", "", "world-fixed frame; gravity and travel are measured in it"),
     "velocity_command_frame": ("str", "base_link", "", "frame of the published twist"),
     "ft_sensor_frame": ("str", "base_link", "", "frame of the wrench (used when the header frame is empty)"),
+    "use_ft_sensor_frame": (
+        "bool", False, "", "ignore header.frame_id, take ft_sensor_frame (a recording in a frame tf lacks)",
+    ),
     "control_frame": ("str", "base_link", "", "frame whose axes X..RZ the laws act along"),
     "eef_frame": ("str", "tool0", "", "end-effector frame whose travel is measured"),
     # timing
@@ -142,6 +145,7 @@ class ContactControlSettings:
     fixed_frame: str = "base_link"
     velocity_command_frame: str = "base_link"
     ft_sensor_frame: str = "base_link"
+    use_ft_sensor_frame: bool = False
     control_frame: str = "base_link"
     eef_frame: str = "tool0"
     control_rate: float = 500.0
