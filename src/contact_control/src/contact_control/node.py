@@ -52,6 +52,7 @@ from contact_control.frames import (
     transpose_times,
 )
 from contact_control.params import PARAMETERS, ContactControlSettings, ParamError, load_settings
+from contact_control.payload_service import PayloadServices
 from contact_control.preprocess import PreprocessError
 from contact_control.request import (
     CODE_NAMES,
@@ -153,6 +154,13 @@ class ContactControlNode:
             rospy.Service(private_ns + "stop", Trigger, self._on_stop),
             rospy.Service(private_ns + "reset", Trigger, self._on_reset),
         ]
+        self._payload = PayloadServices(
+            private_ns,
+            self._sensor_rotation,
+            lambda: "a move is running (stop it: the tool must be free)" if self._ctrl.move_active else "",
+            self._ctrl.preprocessor.oriented,
+            s.gravity,
+        )
         self._sub = rospy.Subscriber(
             s.ft_in_topic, WrenchStamped, self._on_wrench, queue_size=1, tcp_nodelay=True
         )
@@ -236,6 +244,8 @@ class ContactControlNode:
         stamp = msg.header.stamp.to_sec() if not msg.header.stamp.is_zero() else None
         header_frame = "" if self._s.use_ft_sensor_frame else msg.header.frame_id
         sensor_frame = header_frame or self._s.ft_sensor_frame
+        if self._payload.sampling:
+            self._payload.feed(wrench)
         with self._lock:
             try:
                 T_cs, R_ws, eef, R_fc, R_cc = self._frames(sensor_frame, self._ctrl.needs_travel)
@@ -394,6 +404,14 @@ class ContactControlNode:
                 self._idle_zeros = int(self._s.idle_zero_count)
                 self._send(_ZERO, rospy.get_time())
         return TriggerResponse(success=True, message="move stopped" if stopped else "no move was running")
+
+    def _sensor_rotation(self) -> list[list[float]]:
+        """The sensor frame's orientation in the fixed frame now (for payload samples)."""
+        with self._lock:
+            try:
+                return [row[:3] for row in self._lookup(self._s.ft_sensor_frame)[:3]]
+            except _TF_ERRORS as err:
+                raise LookupError(str(err)) from err
 
     def _on_reset(self, _req: Any) -> TriggerResponse:
         with self._lock:

@@ -124,6 +124,10 @@ class WrenchPreprocessor:
         cx, cy, cz = self._com
         return [fx, fy, fz, cy * fz - cz * fy, cz * fx - cx * fz, cx * fy - cy * fx]
 
+    def oriented(self, raw: Sequence[float]) -> list[float]:
+        """The raw wrench with the configured sign flips (what `gravity_wrench` + bias model), a new list."""
+        return self._flipped(raw)
+
     def _flipped(self, raw: Sequence[float]) -> list[float]:
         w = [float(v) for v in raw]
         if self._flip:
