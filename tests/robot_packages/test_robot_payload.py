@@ -1,9 +1,10 @@
-"""Payload identification on the simulated arms: `rosrun contact_control identify_payload robot` tilts the tool
-through seven orientations by jogging, samples the wrench at each, and fits the tool the robot package
+"""Payload identification on the simulated arms: `rosrun contact_control identify_payload robot` tilts the
+tool through seven orientations by jogging, samples the wrench at each, and fits the tool the robot package
 configured (1.0 kg, centre of mass 0.05 m out along the sensor's Z) within 5 % and 5 mm."""
 
 from __future__ import annotations
 
+import pathlib
 import re
 import subprocess
 
@@ -21,8 +22,6 @@ CONFIG = {"ur5_custom": "src/ur5_custom/config/contact_control.yaml",
 
 @pytest.mark.parametrize("robot", ["ur5_custom", "panda_custom"])
 def test_identify_recovers_the_configured_tool(ros_node, robot):
-    import pathlib
-
     config = yaml.safe_load((pathlib.Path(__file__).resolve().parents[2] / CONFIG[robot]).read_text())
     with run_launch(robot, "sim.launch") as h:
         h.wait_for_service("/contact_control_node/payload/identify", timeout=40)
