@@ -1,7 +1,8 @@
 """Typed settings of contact control, loaded once from the YAML / parameter-server dict and validated.
 
-Every key of the original `contact_control_conf.yaml` is accepted (SPEC section 5); the additions carry units
-in their names or in `PARAMETERS` below, which is also the table the README documents. Errors name the key.
+Every key of the original `contact_control_conf.yaml` is accepted (see the package README); the additions
+carry units in their names or in `PARAMETERS` below, which is also the table the README documents. Errors
+name the key.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """ConfigureForceControl request <-> six per-axis laws, with validation (no ROS import; duck-typed).
 
-Mapping per axis (SPEC section 3), with p = req.cart_impedance_params and c the axis letter x, y or z:
+Mapping per axis (the package README's table), with p = req.cart_impedance_params, c the axis letter:
 
 =============  ====================================  =======================================
                X, Y, Z                                RX, RY, RZ

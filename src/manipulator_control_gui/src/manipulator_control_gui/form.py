@@ -1,6 +1,6 @@
 """The per-axis form and its mapping to a ConfigureForceControl request (pure: no Qt, no rospy).
 
-Mapping per axis (SPEC section 3), p = request.cart_impedance_params, c = x, y or z:
+Mapping per axis (contact_control's README), p = request.cart_impedance_params, c = x, y or z:
 
 ===================  ====================================  =====================================
 form field           X, Y, Z                               RX, RY, RZ

@@ -39,7 +39,7 @@ class Names:
 
 
 def build_request(scenario: Scenario) -> ConfigureForceControlRequest:
-    """The ConfigureForceControl request for a scenario (SPEC section 3 mapping)."""
+    """The ConfigureForceControl request for a scenario (the mapping in contact_control's README)."""
     req = ConfigureForceControlRequest()
     p = req.cart_impedance_params
     for axis in AXES:
