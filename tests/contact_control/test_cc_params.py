@@ -48,12 +48,14 @@ def test_defaults_are_the_fork_numbers():
     assert s.control_rate == 500.0
 
 
-def test_top_level_keys_win_over_nested_and_unknown_keys_are_reported():
-    s = load_settings(
-        {"contact_control": {"max_velocity": 0.1, "old_key": 1}, "max_velocity": 0.2, "typo": 3}
-    )
+def test_top_level_keys_win_over_nested_and_unknown_keys_refuse_start_up():
+    s = load_settings({"contact_control": {"max_velocity": 0.1}, "max_velocity": 0.2})
     assert s.max_velocity == 0.2
-    assert s.unknown_keys == ("old_key", "typo")
+    typo = "global_max_forse is not a parameter: did you mean global_max_force"
+    with pytest.raises(ParamError, match=typo):
+        load_settings({"global_max_forse": 30.0})
+    with pytest.raises(ParamError, match="old_key is not a parameter: see the package README"):
+        load_settings({"contact_control": {"old_key": 1}})
 
 
 def test_every_parameter_is_a_settings_field_with_the_same_default():

@@ -68,20 +68,18 @@ def test_bad_settings_refused_naming_the_key(params: dict, key: str) -> None:
         JogSettings.from_params(params)
 
 
-def test_renamed_and_unknown_keys_warn() -> None:
+def test_renamed_keys_warn_and_unknown_keys_refuse_start_up() -> None:
     _, warnings = JogSettings.from_params_with_warnings(
-        {
-            "lower_singularity_threshold": 17.0,
-            "publish_period": 0.01,
-            "bogus": 1,
-            "robot_description": "<robot/>",
-        }
+        {"lower_singularity_threshold": 17.0, "publish_period": 0.01, "robot_description": "<robot/>"}
     )
     text = "\n".join(warnings)
     assert "use jog_arm_server/singularity_threshold" in text
     assert "use jog_arm_server/pub_period" in text
-    assert "bogus is not a jog_arm parameter" in text
     assert "robot_description" not in text
+    with pytest.raises(SettingsError, match="jog_arm_server/bogus is not a parameter"):
+        JogSettings.from_params_with_warnings({"bogus": 1})
+    with pytest.raises(SettingsError, match="did you mean jog_arm_server/incoming_cmd_timeout"):
+        JogSettings.from_params({"incoming_cmd_timout": 0.1})
 
 
 def test_model_locks_joints_that_are_not_controlled() -> None:

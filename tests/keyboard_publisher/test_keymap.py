@@ -269,11 +269,13 @@ def test_bad_parameters_are_refused_naming_the_key(params, key):
 
 
 def test_parameters_load_with_defaults_ints_and_warnings():
-    settings, warnings = TeleopSettings.from_params({"rate": 20, "frame_id": "tool0", "key_timout": 1.0})
+    settings, warnings = TeleopSettings.from_params({"rate": 20, "frame_id": "tool0"})
     assert settings.rate == 20.0 and isinstance(settings.rate, float)
     assert settings.frame_id == "tool0"
     assert settings.topic == "jog_arm_server/delta_jog_cmds"
     assert settings.linear_speed == 0.2
-    assert warnings == ["unknown parameter '~key_timout' ignored"]
+    assert warnings == []
+    with pytest.raises(SettingsError, match="~key_timout is not a parameter: did you mean ~key_timeout"):
+        TeleopSettings.from_params({"rate": 20, "key_timout": 1.0})
     _, warnings = TeleopSettings.from_params({"key_timeout": 0.3})
     assert any("repeat delay" in w for w in warnings)

@@ -485,9 +485,6 @@ def read_settings(param_ns: str = "~") -> ContactControlSettings | None:
     except ParamError as err:
         rospy.logfatal("contact_control_node: bad configuration, not starting: %s", err)
         return None
-    if settings.unknown_keys:
-        rospy.logwarn("contact_control_node: ignoring unknown parameters %s (known: see the README)",
-                      ", ".join(settings.unknown_keys))
     return settings
 
 

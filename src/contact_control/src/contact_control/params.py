@@ -12,6 +12,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from typing import Any
 
+from compliant_common.keys import unknown_key_message
+
 __all__ = ["PARAMETERS", "AxisTuning", "ContactControlSettings", "ParamError", "load_settings"]
 
 
@@ -319,6 +321,8 @@ def load_settings(params: Mapping[str, Any] | None = None) -> ContactControlSett
         if key in merged:
             values[key] = _convert(key, kind, merged[key])
     unknown = tuple(sorted(k for k in merged if k not in PARAMETERS))
+    if unknown:
+        raise ParamError(unknown[0], unknown_key_message(unknown[0], PARAMETERS))
     names = {f.name for f in fields(ContactControlSettings)}
     assert names >= set(PARAMETERS), "PARAMETERS and ContactControlSettings disagree"
     settings = ContactControlSettings(**values, unknown_keys=unknown)

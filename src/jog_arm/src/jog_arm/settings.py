@@ -11,6 +11,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from typing import Any
 
+from compliant_common.keys import unknown_key_message
+
 __all__ = [
     "COMMAND_IN_TYPES",
     "COMMAND_OUT_TYPES",
@@ -142,7 +144,7 @@ class JogSettings:
                 hint = f"use {prefix}{new}" if new else "not supported, ignored"
                 warnings.append(f"{prefix}{key} is a renamed or unsupported key: {hint}")
             else:
-                warnings.append(f"{prefix}{key} is not a jog_arm parameter, ignored")
+                raise SettingsError(unknown_key_message(key, known | set(_NODE_ONLY), prefix))
 
         reader = _Reader(flat, prefix)
         defaults = cls()

@@ -19,6 +19,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from typing import Any, NamedTuple
 
+from compliant_common.keys import unknown_key_message
+
 from keyboard_publisher.keymap import KEYMAP, Action, Binding
 
 __all__ = [
@@ -122,13 +124,16 @@ class TeleopSettings:
         Integers are accepted for float parameters (`_rate:=50`).
 
         Returns:
-            The settings and warnings (unknown keys, a key_timeout below the usual repeat delay).
+            The settings and warnings (a key_timeout below the usual repeat delay).
 
         Raises:
-            SettingsError: a value has the wrong type or range.
+            SettingsError: an unknown key (naming the closest valid one), a wrong type or range.
         """
         known = {f.name for f in fields(cls)}
-        warnings = [f"unknown parameter '~{key}' ignored" for key in sorted(params) if key not in known]
+        for key in sorted(params):
+            if key not in known:
+                raise SettingsError(key, unknown_key_message(key, known, "~"))
+        warnings: list[str] = []
         values: dict[str, Any] = {}
         for key in known & set(params):
             value = params[key]
