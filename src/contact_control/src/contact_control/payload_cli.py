@@ -67,9 +67,13 @@ def _robot(args: argparse.Namespace) -> int:
                 msg.header.stamp = rospy.Time.now()
                 twist_pub.publish(msg)
                 rate.sleep()
-        quiet_since = time.monotonic()
-        while time.monotonic() - quiet_since < 0.3 and not rospy.is_shutdown():
-            if speeds and speeds[-1] > 2e-3:
+        # At rest: 0.2 s without joint motion; on a loaded machine the servos jitter, so give up waiting
+        # after 10 s (add_sample still refuses a sensor that turns while it samples).
+        started = quiet_since = time.monotonic()
+        while time.monotonic() - quiet_since < 0.2 and time.monotonic() - started < 10.0:
+            if rospy.is_shutdown():
+                return
+            if speeds and speeds[-1] > 5e-3:
                 quiet_since = time.monotonic()
             time.sleep(0.02)
 
@@ -79,9 +83,12 @@ def _robot(args: argparse.Namespace) -> int:
         target = (tx * args.tilt, ty * args.tilt)
         tilt(target[0] - at[0], target[1] - at[1])
         at = target
-        answer = call["add_sample"]()
-        print(answer.message)
-        if not answer.success:
+        for _attempt in range(3):  # a stall of the machine can turn the sensor while it samples
+            answer = call["add_sample"]()
+            print(answer.message, flush=True)
+            if answer.success:
+                break
+        else:
             return 1
     tilt(-at[0], -at[1])  # back to where it started
     answer = call["identify"]()

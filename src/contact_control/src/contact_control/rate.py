@@ -1,11 +1,12 @@
 """The sensor's real sample period, measured from the wrenches themselves.
 
-Real sensors publish at their own rate (UR e-Series `wrench` 500 Hz, franka's `F_ext` at its controller's
-`publish_rate`, 30 Hz by default, 92 Hz seen in a recording; an ATI box at 125-7000 Hz), which is rarely the
-`lp_filter_delta_t` somebody typed. A filter designed for the wrong period has the wrong cutoff (the
-configured 5 Hz became 0.92 Hz on 92 Hz data), and a fixed stale timeout is either shorter than one period
-of a slow sensor or far too long for a fast one. The period is the median of recent sample intervals, so
-single late or dropped samples do not move it; gaps longer than `MAX_INTERVAL` (dropouts) are left out.
+Real sensors publish at their own rate (an arm's built-in sensor at 500 Hz, a model-based estimate at its
+controller's publish rate, 30 Hz by default or 92 Hz in one recording, a separate F/T box at 125-7000 Hz),
+which is rarely the `lp_filter_delta_t` somebody typed. A filter designed for the wrong period has the wrong
+cutoff (the configured 5 Hz became 0.92 Hz on 92 Hz data), and a fixed stale timeout is either shorter than
+one period of a slow sensor or far too long for a fast one (the package README has the numbers). The period
+is the median of recent sample intervals, so single late or dropped samples do not move it; gaps longer than
+`MAX_INTERVAL` (dropouts) are left out.
 """
 
 from __future__ import annotations
