@@ -82,7 +82,8 @@ class MasterWatch:
     def close(self) -> None:
         self._closed = True
 
-    def _proxy(self) -> xmlrpc.client.ServerProxy:
+    def _proxy(self) -> Any:
+        """The master's XML-RPC API (Any: its answers are untyped (code, message, value) triples)."""
         return xmlrpc.client.ServerProxy(self._uri, transport=_TimeoutTransport(max(self._period, 0.2)))
 
     def _run(self) -> None:
