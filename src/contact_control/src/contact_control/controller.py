@@ -35,6 +35,7 @@ from contact_control.axes import (
     END_NO_FT_DATA,
     END_NONE,
     LAW_FOLLOWER,
+    LAW_FORCE_TRACKING,
     LAW_NONE,
     SAFETY_NAN,
     SAFETY_OK,
@@ -51,6 +52,7 @@ from contact_control.travel import TravelMeter
 __all__ = ["AxisState", "ContactControl", "CycleResult"]
 
 _ZEROS = (0.0,) * 6
+_NO_TRAVEL = (LAW_FOLLOWER, LAW_FORCE_TRACKING)  # laws that need no travel unless they have a max travel
 
 
 
@@ -189,6 +191,7 @@ class ContactControl:
         self._active: tuple[int, ...] = ()
         self._diff_axes: tuple[int, ...] = ()
         self._needs_travel = False
+        self._floor = [True] * 6  # per axis: zero commands below min velocity (not for force tracking)
         self._v = [0.0] * 6
         self._travel = [0.0] * 6
         self._wrench = [0.0] * 6
@@ -287,7 +290,8 @@ class ContactControl:
         self._actions = [law.exceeded_action if law.law and law.force_limit > 0.0 else -1 for law in laws]
         self._active = tuple(i for i in range(6) if laws[i].law != LAW_NONE)
         self._diff_axes = tuple(i for i in self._active if self._diff[i] > 0.0)
-        self._needs_travel = any(law.law != LAW_FOLLOWER or law.max_travel > 0.0 for law in laws if law.law)
+        self._needs_travel = any(law.law not in _NO_TRAVEL or law.max_travel > 0.0 for law in laws if law.law)
+        self._floor = [law.law != LAW_FORCE_TRACKING for law in laws]
         for window in self._windows:
             window.clear()
         self._v = [0.0] * 6
@@ -331,7 +335,8 @@ class ContactControl:
         self._actions = [law.exceeded_action if law.law and law.force_limit > 0.0 else -1 for law in laws]
         self._active = tuple(i for i in range(6) if laws[i].law != LAW_NONE)
         self._diff_axes = tuple(i for i in self._active if self._diff[i] > 0.0)
-        self._needs_travel = any(law.law != LAW_FOLLOWER or law.max_travel > 0.0 for law in laws if law.law)
+        self._needs_travel = any(law.law not in _NO_TRAVEL or law.max_travel > 0.0 for law in laws if law.law)
+        self._floor = [law.law != LAW_FORCE_TRACKING for law in laws]
         self._end = [END_NONE] * 6
         self._ended_axis = -1
         self._move_id += 1
@@ -448,9 +453,11 @@ class ContactControl:
         last = self._last_t
         dt = self._dt_nominal if last is None else min(max(t - last, 0.0), self._timeout)
         self._last_t = t
-        v, tuning = self._v, self._tuning
+        v, tuning, floor = self._v, self._tuning, self._floor
         for i in self._active:
-            v[i] = shape_velocity(law_velocity(laws[i], tuning[i], w[i], travel[i]), v[i], tuning[i], dt)
+            v[i] = shape_velocity(
+                law_velocity(laws[i], tuning[i], w[i], travel[i]), v[i], tuning[i], dt, floor[i]
+            )
         if not all(armed):
             if self._from_rest is None:
                 self._from_rest = t

@@ -37,6 +37,7 @@ from contact_control.axes import (
     END_NAMES,
     EXCEEDED_ACTION_NAMES,
     LAW_COMPLIANT_MOVE,
+    LAW_FORCE_TRACKING,
     LAW_NAMES,
     SAFETY_NAMES,
     SAFETY_NO_TF,
@@ -438,6 +439,8 @@ def describe_laws(move_id: int, laws: Sequence[Any]) -> str:
     for i, law in enumerate(laws):
         if law.law:
             notes = [f"v {law.velocity:g}"] if law.law == LAW_COMPLIANT_MOVE else []
+            if law.law == LAW_FORCE_TRACKING:
+                notes = [f"target {law.target:g}", f"b {law.damping:g}", f"approach {law.velocity:g}"]
             if law.exceeded_action:
                 notes.append(EXCEEDED_ACTION_NAMES[law.exceeded_action])
             parts.append(f"{AXES[i]}={LAW_NAMES[law.law]}" + (f" ({', '.join(notes)})" if notes else ""))
