@@ -465,6 +465,30 @@ class ContactControl:
                 self._armed = [True] * 6
         return self._result(t, SAFETY_OK, "")
 
+    def contact_force(
+        self, wrench: Sequence[float], T_control_sensor: Any = None, R_world_sensor: Any = None
+    ) -> tuple[float, float, float] | None:
+        """The contact force of a raw wrench, unfiltered: sign flips, bias and tool weight out, in the control
+        frame [N]; None for a NaN/inf wrench or a missing orientation. For guards that must see a contact as
+        early as possible (jog_arm's contact guard): the low-pass filter of the laws lags it by tens of ms.
+        It reads the current bias and tool model and changes nothing (no filter step, no limit check).
+        """
+        if len(wrench) != 6 or not is_finite6(wrench):
+            return None
+        p = self.preprocessor
+        f = [float(wrench[i]) * self.settings.ft_directions[i] for i in range(3)]
+        b = p.bias
+        f = [f[i] - b[i] for i in range(3)]
+        if self.settings.tool_mass > 0.0:
+            if R_world_sensor is None:
+                return None
+            g = p.gravity_wrench(R_world_sensor)
+            f = [f[i] - g[i] for i in range(3)]
+        if T_control_sensor is None:
+            return (f[0], f[1], f[2])
+        r = [[float(T_control_sensor[i][j]) for j in range(3)] for i in range(3)]
+        return tuple(r[i][0] * f[0] + r[i][1] * f[1] + r[i][2] * f[2] for i in range(3))  # type: ignore[return-value]
+
     @property
     def fresh_until(self) -> float:
         """Time [s] until which the newest wrench counts as fresh (-inf before the first one)."""
