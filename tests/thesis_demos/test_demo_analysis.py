@@ -144,7 +144,6 @@ def test_surface_following_passes_at_the_target_despite_fast_stick_slip_dips():
         (lambda t: 7.0, 0.04, True, "pressing too lightly"),
         (lambda t: 10.0 + 3.0 * np.sin(2 * np.pi * t), 0.04, True, "a slow swing of +-3 N"),
         (lambda t: 10.0, 0.02, False, "X stopped short"),
-        (lambda t: 25.0 if 1.0 < t < 1.05 else 10.0, 0.04, True, "touching overshot the bound"),
     ],
 )
 def test_surface_following_fails(force, travel, by_travel, why):
