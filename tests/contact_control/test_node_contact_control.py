@@ -516,3 +516,31 @@ def test_wrench_stamped_in_the_future_gives_zero_twist_and_a_reason_then_resumes
     wait_until(ahead, 10, "a zero twist and the reason for a wrench stamped 5 s ahead")
     assert node.status.last().move_active
     wait_twist(node, lambda t: t[2] == pytest.approx(0.2), [0, 0, 6.0, 0, 0, 0], "following again")
+
+
+def test_readme_force_tracking_presses_down_until_the_table_pushes_back_with_the_target(fresh):
+    """README: force tracking on Z, 10 N pressing down on a table (target_force +10: the table pushes up)."""
+    node = fresh
+    answer = rosservice(readme_command("law: 4"))
+    assert "success: True" in answer
+    assert "z=force_tracking (target 10, b 2000, approach 0.01, move_away)" in answer
+    approach = node.settings.compliant_default_velocity_linear
+    # Free air: down toward the table at the approach speed (no deadband around zero force).
+    wait_twist(node, lambda t: t[2] == pytest.approx(-approach), [0] * 6, "the approach, down")
+    # Touching with 8 N: still pressing, at (F - F_target) / b (slower than min_velocity: no floor here).
+    wait_twist(node, lambda t: t[2] == pytest.approx(-2.0 / 2000.0), [0, 0, 8.0, 0, 0, 0], "pressing harder")
+    # At the target (within the 0.2 N deadband) it holds; above it, it eases off upward.
+    wait_twist(node, lambda t: t[2] == 0.0, [0, 0, 10.1, 0, 0, 0], "holding at the target")
+    wait_twist(node, lambda t: t[2] == pytest.approx(3.0 / 2000.0), [0, 0, 13.0, 0, 0, 0], "easing off")
+    status = latest_status(node, lambda s: s.move_active, "the move in ~status",
+                           keep_publishing=([0, 0, 13.0, 0, 0, 0], "ft_sensor"))
+    assert status.axes[2].law_name == "force_tracking" and status.axes[2].exceeded_action == "move_away"
+    # The original service has no force tracking: refused, naming the service that has it.
+    answer = rosservice(
+        'rosservice call /configure_cartesian_impedance "{cart_impedance_params: {damping: {translational: '
+        '{z: 2000.0}}}, direction_control_laws: {z: {type: 4}}}"'
+    )
+    assert "success: False" in answer
+    status = latest_status(node, lambda s: "configure_laws" in s.message, "the refusal's reason in ~status",
+                           keep_publishing=([0, 0, 13.0, 0, 0, 0], "ft_sensor"))
+    assert status.move_active and status.axes[2].law_name == "force_tracking"  # nothing changed

@@ -253,3 +253,20 @@ def test_trajectory_points_reorder_and_fill_missing_joints_with_the_hold_positio
 def test_trajectory_points_refuse_malformed_messages(names, points, match):
     with pytest.raises(CommandError, match=match):
         trajectory_points(names, points, _indices, np.zeros(3))
+
+
+def test_latency_probe_survives_a_command_emptying_the_queue_during_wrench_sent():
+    """The subscriber thread's command_received can pop the wrench wrench_sent has just appended (seen on a
+    loaded VM: the driver died with IndexError in the middle of `make demo ROBOT=panda`)."""
+    import collections
+
+    probe = LatencyProbe(horizon=0.1)
+
+    class Racing(collections.deque):
+        def append(self, t):  # the other thread answers right after the append
+            super().append(t)
+            probe.command_received(t + 0.0002, wall=9.0)
+
+    probe._pending = Racing()
+    probe.wrench_sent(1.0)  # must not raise
+    assert probe.take() == pytest.approx([9.0, 0.0002])

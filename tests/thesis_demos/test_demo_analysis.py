@@ -111,3 +111,41 @@ def test_a_run_that_ended_before_its_push_fails_instead_of_crashing():
     early = _recording(0.5, x=_ramp(0.0, 0.5, -0.05), ends={"x": 1}, end_time=0.3)
     verdict = judge(scenario, early)
     assert not verdict.passed
+
+
+def _surface_recording(force, x_travel=0.04, ended_by_travel=True):
+    """Presses from t = 1 s, X moves from t = 2 s at 0.01 m/s; `force(t)` is the contact force on Z."""
+    duration = 2.0 + x_travel / 0.01
+    rec = _recording(
+        duration + 0.5,
+        x=_ramp(2.0, duration, -0.01),
+        ends={"x": 2 if ended_by_travel else 0, "z": 0},
+        end_time=duration,
+        contact_z=force,
+    )
+    rec.follow_up_time = 2.0
+    return rec
+
+
+def test_surface_following_passes_at_the_target_despite_fast_stick_slip_dips():
+    scenario = by_name(["surface_following"])[0]
+    # The simulated tool face sliding on the block: the raw force drops to 2.5 N for one 2 ms step every
+    # 16 ms; its 50 ms means stay at the target.
+    rec = _surface_recording(lambda t: 2.5 if round(t * RATE) % 8 == 0 else 11.07)
+    verdict = judge(scenario, rec)
+    assert verdict.passed, verdict.summary
+    assert abs(verdict.figures["mean contact force over the travel [N]"] - 10.0) < 0.1
+    assert verdict.figures["raw sample std (65 Hz stick-slip) [N]"] > 2.0
+
+
+@pytest.mark.parametrize(
+    "force, travel, by_travel, why",
+    [
+        (lambda t: 7.0, 0.04, True, "pressing too lightly"),
+        (lambda t: 10.0 + 3.0 * np.sin(2 * np.pi * t), 0.04, True, "a slow swing of +-3 N"),
+        (lambda t: 10.0, 0.02, False, "X stopped short"),
+    ],
+)
+def test_surface_following_fails(force, travel, by_travel, why):
+    verdict = judge(by_name(["surface_following"])[0], _surface_recording(force, travel, by_travel))
+    assert not verdict.passed, why

@@ -94,3 +94,17 @@ def test_no_robot_name_in_library_code(package):
         text = path.read_text().lower()
         offenders += [f"{path.relative_to(SRC)}: {n}" for n in names if n in text]
     assert not offenders
+
+
+def test_surface_following_holds_the_target_force_while_x_travels(stack):
+    from thesis_demos.scenarios import SURFACE_TARGET_FORCE, SURFACE_TOLERANCE, SURFACE_TRAVEL
+
+    robot, verdict = _run(stack, "surface_following")
+    f = verdict.figures
+    print(f"{robot}: {verdict.summary}")
+    assert abs(f["x travel [m]"] - SURFACE_TRAVEL) < 0.01, (robot, verdict.summary)
+    assert abs(f["mean contact force over the travel [N]"] - SURFACE_TARGET_FORCE) <= SURFACE_TOLERANCE, (
+        robot, verdict.summary)
+    assert f["50 ms means min [N]"] >= SURFACE_TARGET_FORCE - SURFACE_TOLERANCE, (robot, verdict.summary)
+    assert f["50 ms means max [N]"] <= SURFACE_TARGET_FORCE + SURFACE_TOLERANCE, (robot, verdict.summary)
+    assert verdict.passed, (robot, verdict.summary)

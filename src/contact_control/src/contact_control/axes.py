@@ -23,6 +23,7 @@ __all__ = [
     "EXCEEDED_STOP",
     "LAW_COMPLIANT_MOVE",
     "LAW_FOLLOWER",
+    "LAW_FORCE_TRACKING",
     "LAW_NAMES",
     "LAW_NONE",
     "LAW_SPRING",
@@ -48,11 +49,14 @@ LAW_NONE = 0  # TYPE_UNKNOWN: the axis does not move
 LAW_FOLLOWER = 1
 LAW_SPRING = 2
 LAW_COMPLIANT_MOVE = 3
+# compliant_control_msgs/AxisLaw FORCE_TRACKING: offered through ConfigureLaws only (ControlLaw stops at 3)
+LAW_FORCE_TRACKING = 4
 LAW_NAMES = {
     LAW_NONE: "none",
     LAW_FOLLOWER: "follower",
     LAW_SPRING: "spring",
     LAW_COMPLIANT_MOVE: "compliant_move",
+    LAW_FORCE_TRACKING: "force_tracking",
 }
 
 # compliant_control_msgs/AxisState end conditions

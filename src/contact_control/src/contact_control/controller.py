@@ -35,6 +35,7 @@ from contact_control.axes import (
     END_NO_FT_DATA,
     END_NONE,
     LAW_FOLLOWER,
+    LAW_FORCE_TRACKING,
     LAW_NONE,
     SAFETY_NAN,
     SAFETY_OK,
@@ -52,6 +53,7 @@ from contact_control.travel import TravelMeter
 __all__ = ["AxisState", "ContactControl", "CycleResult"]
 
 _ZEROS = (0.0,) * 6
+_NO_TRAVEL = (LAW_FOLLOWER, LAW_FORCE_TRACKING)  # laws that need no travel unless they have a max travel
 
 
 
@@ -193,6 +195,7 @@ class ContactControl:
         self._active: tuple[int, ...] = ()
         self._diff_axes: tuple[int, ...] = ()
         self._needs_travel = False
+        self._floor = [True] * 6  # per axis: zero commands below min velocity (not for force tracking)
         self._v = [0.0] * 6
         self._travel = [0.0] * 6
         self._wrench = [0.0] * 6
@@ -291,7 +294,8 @@ class ContactControl:
         self._actions = [law.exceeded_action if law.law and law.force_limit > 0.0 else -1 for law in laws]
         self._active = tuple(i for i in range(6) if laws[i].law != LAW_NONE)
         self._diff_axes = tuple(i for i in self._active if self._diff[i] > 0.0)
-        self._needs_travel = any(law.law != LAW_FOLLOWER or law.max_travel > 0.0 for law in laws if law.law)
+        self._needs_travel = any(law.law not in _NO_TRAVEL or law.max_travel > 0.0 for law in laws if law.law)
+        self._floor = [law.law != LAW_FORCE_TRACKING for law in laws]
         for window in self._windows:
             window.clear()
         self._v = [0.0] * 6
@@ -335,7 +339,8 @@ class ContactControl:
         self._actions = [law.exceeded_action if law.law and law.force_limit > 0.0 else -1 for law in laws]
         self._active = tuple(i for i in range(6) if laws[i].law != LAW_NONE)
         self._diff_axes = tuple(i for i in self._active if self._diff[i] > 0.0)
-        self._needs_travel = any(law.law != LAW_FOLLOWER or law.max_travel > 0.0 for law in laws if law.law)
+        self._needs_travel = any(law.law not in _NO_TRAVEL or law.max_travel > 0.0 for law in laws if law.law)
+        self._floor = [law.law != LAW_FORCE_TRACKING for law in laws]
         self._end = [END_NONE] * 6
         self._ended_axis = -1
         self._move_id += 1
@@ -481,15 +486,41 @@ class ContactControl:
         last = self._last_t
         dt = self._dt_nominal if last is None else min(max(t - last, 0.0), self._timeout)
         self._last_t = t
-        v, tuning = self._v, self._tuning
+        v, tuning, floor = self._v, self._tuning, self._floor
         for i in self._active:
-            v[i] = shape_velocity(law_velocity(laws[i], tuning[i], w[i], travel[i]), v[i], tuning[i], dt)
+            v[i] = shape_velocity(
+                law_velocity(laws[i], tuning[i], w[i], travel[i]), v[i], tuning[i], dt, floor[i]
+            )
         if not all(armed):
             if self._from_rest is None:
                 self._from_rest = t
             if t - self._from_rest >= self._arm_time:
                 self._armed = [True] * 6
         return self._result(t, SAFETY_OK, "")
+
+    def contact_force(
+        self, wrench: Sequence[float], T_control_sensor: Any = None, R_world_sensor: Any = None
+    ) -> tuple[float, float, float] | None:
+        """The contact force of a raw wrench, unfiltered: sign flips, bias and tool weight out, in the control
+        frame [N]; None for a NaN/inf wrench or a missing orientation. For guards that must see a contact as
+        early as possible (jog_arm's contact guard): the low-pass filter of the laws lags it by tens of ms.
+        It reads the current bias and tool model and changes nothing (no filter step, no limit check).
+        """
+        if len(wrench) != 6 or not is_finite6(wrench):
+            return None
+        p = self.preprocessor
+        f = [float(wrench[i]) * self.settings.ft_directions[i] for i in range(3)]
+        b = p.bias
+        f = [f[i] - b[i] for i in range(3)]
+        if self.settings.tool_mass > 0.0:
+            if R_world_sensor is None:
+                return None
+            g = p.gravity_wrench(R_world_sensor)
+            f = [f[i] - g[i] for i in range(3)]
+        if T_control_sensor is None:
+            return (f[0], f[1], f[2])
+        r = [[float(T_control_sensor[i][j]) for j in range(3)] for i in range(3)]
+        return tuple(r[i][0] * f[0] + r[i][1] * f[1] + r[i][2] * f[2] for i in range(3))  # type: ignore[return-value]
 
     @property
     def fresh_until(self) -> float:

@@ -8,6 +8,13 @@ the law was set [m] ([rad]), V the commanded velocity [m/s] ([rad/s]):
   k is in 1/s here (GCCF's form), the equivalent impedance stiffness is b * k [N/m].
 - compliant move: V = V_desired + F / b (no force term when b = 0); within `slowdown` of the max travel the
   speed falls linearly with the remaining travel, never below `approach_speed`.
+- force tracking: V = (F - F_target) / b, so the axis presses until the contact force F reaches the target
+  (F as the follower reads it: a table under the tool pushes +Z, so pressing down with 10 N is F_target 10).
+  No deadband around zero force (free air must move the tool toward the contact), but V = 0 while
+  |F - F_target| <= `track_deadband`, and no minimum velocity (a stiff surface needs a large b, so small
+  corrections are slow ones). Out of contact (F short of `contact_fraction` of the target, on the target's
+  side) the axis approaches at least at the law's approach speed (`velocity`) toward the contact, since
+  (F - F_target) / b with a b fit for a stiff surface would creep for a long time through free air.
 - none: V = 0.
 
 `shape_velocity` then zeroes |V| <= min_velocity, clamps to the max velocity and limits acceleration and
@@ -28,6 +35,7 @@ from contact_control.axes import (
     EXCEEDED_STOP,
     LAW_COMPLIANT_MOVE,
     LAW_FOLLOWER,
+    LAW_FORCE_TRACKING,
     LAW_NONE,
     LAW_SPRING,
 )
@@ -41,15 +49,18 @@ class AxisLaw:
     """The law of one axis and its parameters (units per axis kind: N or Nm, m or rad, s).
 
     Attributes:
-        law: LAW_NONE, LAW_FOLLOWER, LAW_SPRING or LAW_COMPLIANT_MOVE.
-        damping: b [N/(m/s)] or [Nm/(rad/s)]; > 0 for follower and spring, >= 0 for compliant move.
+        law: LAW_NONE, LAW_FOLLOWER, LAW_SPRING, LAW_COMPLIANT_MOVE or LAW_FORCE_TRACKING.
+        damping: b [N/(m/s)] or [Nm/(rad/s)]; > 0 for follower, spring and force tracking, >= 0 for compliant
+            move.
         stiffness: k [1/s] of the spring law.
-        velocity: V_desired of the compliant move [m/s] or [rad/s]; its sign is the direction.
+        velocity: V_desired of the compliant move [m/s] or [rad/s]; its sign is the direction. Force tracking:
+            the approach speed (> 0) while out of contact.
         force_limit: |F| at or above this ends the move (FT_VIOLATION); 0: no limit.
         max_travel: |d| at or above this ends the move (MAX_TRAVEL); 0: no limit.
         offset: d_offset of the spring law [m] or [rad].
         exceeded_action: EXCEEDED_STOP, EXCEEDED_MOVE_AWAY or EXCEEDED_GRAVITY_COMPENSATION: what this axis
             does once the move has ended on a force limit (see `exceeded.ExceededReaction`).
+        target: F_target of force tracking [N] or [Nm], in the sign convention of F.
     """
 
     law: int = LAW_NONE
@@ -60,6 +71,7 @@ class AxisLaw:
     max_travel: float = 0.0
     offset: float = 0.0
     exceeded_action: int = EXCEEDED_STOP
+    target: float = 0.0
 
 
 def round_to(value: float, step: float) -> float:
@@ -88,10 +100,24 @@ def law_velocity(law: AxisLaw, tuning: AxisTuning, force: float, travel: float) 
         if law.damping > 0.0:
             v += force / law.damping
         return v
+    if kind == LAW_FORCE_TRACKING:
+        error = force - law.target
+        if -tuning.track_deadband <= error <= tuning.track_deadband:
+            return 0.0
+        v = error / law.damping
+        target = law.target
+        # Out of contact: the force has not come up to contact_fraction of the target on the target's side.
+        if target > 0.0 and force < tuning.contact_fraction * target:
+            return min(v, -law.velocity)
+        if target < 0.0 and force > tuning.contact_fraction * target:
+            return max(v, law.velocity)
+        return v
     return 0.0
 
 
-def shape_velocity(target: float, previous: float, tuning: AxisTuning, dt: float) -> float:
+def shape_velocity(
+    target: float, previous: float, tuning: AxisTuning, dt: float, floor: bool = True
+) -> float:
     """Applies min velocity, the velocity clamp and the acceleration/deceleration limits.
 
     Args:
@@ -99,8 +125,9 @@ def shape_velocity(target: float, previous: float, tuning: AxisTuning, dt: float
         previous: the velocity commanded last cycle.
         tuning: limits of this axis kind.
         dt: time since the last cycle [s].
+        floor: zero |target| <= min velocity (False for force tracking, which has its own deadband).
     """
-    if -tuning.min_velocity <= target <= tuning.min_velocity:
+    if floor and -tuning.min_velocity <= target <= tuning.min_velocity:
         target = 0.0
     elif target > tuning.max_velocity:
         target = tuning.max_velocity

@@ -37,6 +37,7 @@ from contact_control.axes import (
     END_NAMES,
     EXCEEDED_ACTION_NAMES,
     LAW_COMPLIANT_MOVE,
+    LAW_FORCE_TRACKING,
     LAW_NAMES,
     SAFETY_NAMES,
     SAFETY_NO_TF,
@@ -141,6 +142,14 @@ class ContactControlNode:
             s.velocity_out_topic, TwistStamped, queue_size=queue, tcp_nodelay=True
         )
         self._status_pub = rospy.Publisher(private_ns + "status", ContactControlStatus, queue_size=10)
+        # The compensated, unfiltered contact force (control frame; torque 0) for jog_arm's contact guard in
+        # the two-node layout, sent only while somebody listens. In control_stack jog_arm calls
+        # `contact_force` instead. Kept up also while the global limit is latched (the guard needs it most).
+        self._contact: tuple[tuple[float, float, float], str, float] | None = None
+        self._contact_msg = WrenchStamped()
+        self._contact_msg.header.frame_id = s.control_frame
+        self._contact_pub = rospy.Publisher(private_ns + "contact_wrench", WrenchStamped, queue_size=1,
+                                            tcp_nodelay=True)
         self._status_msg = ContactControlStatus(axes=[AxisState(axis=name) for name in AXES])
         self._status_msg.header.frame_id = s.control_frame
         # Service names in the node's namespace (not private), as the original served them.
@@ -257,9 +266,27 @@ class ContactControlNode:
                     for note in self._ctrl.notes:
                         rospy.logwarn("contact_control: %s", note)
                     self._ctrl.notes.clear()
+                force = self._ctrl.contact_force(wrench, T_cs, R_ws)  # after the twist: off its path
+                if force is not None:
+                    self._note_contact(force, t)
                 if self._frame_source is not None:  # the model caches poses per joint state: fill it now,
                     with contextlib.suppress(*_TF_ERRORS, LookupError):  # off the wrench-to-twist path
                         self._frames(sensor_frame, self._ctrl.needs_travel)
+
+    def _note_contact(self, force: Sequence[float], t: float) -> None:
+        """Keeps the compensated contact force for jog_arm's guard (lock held); publishes it if listened."""
+        self._contact = ((force[0], force[1], force[2]), self._s.control_frame, t)
+        if self._contact_pub.get_num_connections() > 0:
+            msg = self._contact_msg
+            msg.header.stamp = rospy.Time.from_sec(t)
+            f = msg.wrench.force
+            f.x, f.y, f.z = force
+            self._contact_pub.publish(msg)
+
+    def contact_force(self) -> tuple[tuple[float, float, float], str, float] | None:
+        """The latest valid compensated contact force: ((fx, fy, fz) [N], control frame, receive time [s]),
+        None before the first; for jog_arm's contact guard in the same process (control_stack)."""
+        return self._contact
 
     def _watch_staleness(self) -> None:
         """Sleeps until the newest wrench turns stale; while data is missing, runs the stale check every
@@ -461,6 +488,8 @@ def describe_laws(move_id: int, laws: Sequence[Any]) -> str:
     for i, law in enumerate(laws):
         if law.law:
             notes = [f"v {law.velocity:g}"] if law.law == LAW_COMPLIANT_MOVE else []
+            if law.law == LAW_FORCE_TRACKING:
+                notes = [f"target {law.target:g}", f"b {law.damping:g}", f"approach {law.velocity:g}"]
             if law.exceeded_action:
                 notes.append(EXCEEDED_ACTION_NAMES[law.exceeded_action])
             parts.append(f"{AXES[i]}={LAW_NAMES[law.law]}" + (f" ({', '.join(notes)})" if notes else ""))

@@ -109,6 +109,16 @@ PARAMETERS: dict[str, tuple[str, Any, str, str]] = {
     ),
     "move_away_max_distance": ("pos", 0.02, "m", "backing off ends after this distance at the latest"),
     "move_away_max_angle": ("pos", 0.2, "rad", "same for rotations"),
+    # force tracking law (ConfigureLaws FORCE_TRACKING)
+    "force_tracking_deadband_force": (
+        "nonneg", 0.2, "N",
+        "force tracking holds still while |F - target| is at most this (no deadband around zero force)",
+    ),
+    "force_tracking_deadband_torque": ("nonneg", 0.02, "Nm", "same for torques"),
+    "force_tracking_contact_fraction": (
+        "pos", 0.5, "",
+        "force tracking approaches at its approach speed until F reaches this fraction of the target",
+    ),
     "diff_max_force": ("nonneg", 0.0, "N", "force change within diff_window that ends a move (0: off)"),
     "diff_max_torque": ("nonneg", 0.0, "Nm", "same for torques"),
     "diff_window": ("pos", 0.1, "s", "time window of the force-jump check"),
@@ -136,6 +146,8 @@ class AxisTuning:
     default_velocity: float = 0.01
     away_velocity: float = 0.01
     away_max_travel: float = 0.02
+    track_deadband: float = 0.2
+    contact_fraction: float = 0.5
 
 
 @dataclass(frozen=True)
@@ -203,6 +215,9 @@ class ContactControlSettings:
     move_away_release_fraction: float = 0.5
     move_away_max_distance: float = 0.02
     move_away_max_angle: float = 0.2
+    force_tracking_deadband_force: float = 0.2
+    force_tracking_deadband_torque: float = 0.02
+    force_tracking_contact_fraction: float = 0.5
     diff_max_force: float = 0.0
     diff_max_torque: float = 0.0
     diff_window: float = 0.1
@@ -240,6 +255,8 @@ class ContactControlSettings:
                 self.compliant_default_velocity_angular,
                 self.move_away_velocity_angular,
                 self.move_away_max_angle,
+                self.force_tracking_deadband_torque,
+                self.force_tracking_contact_fraction,
             )
         return AxisTuning(
             self.follower_deadband_force,
@@ -255,6 +272,8 @@ class ContactControlSettings:
             self.compliant_default_velocity_linear,
             self.move_away_velocity_linear,
             self.move_away_max_distance,
+            self.force_tracking_deadband_force,
+            self.force_tracking_contact_fraction,
         )
 
 
@@ -352,6 +371,8 @@ def _check_cross_constraints(s: ContactControlSettings) -> None:
             # Not above the clamp (it would be cut anyway), above min velocity (it would never move).
             if not t.min_velocity < value <= t.max_velocity:
                 raise ParamError(key, f"must exceed min_velocity_{suffix} and not exceed {t.max_velocity}")
+    if s.force_tracking_contact_fraction > 1.0:
+        raise ParamError("force_tracking_contact_fraction", "must be at most 1 (a fraction of the target)")
     if s.move_away_release_fraction >= 1.0:
         raise ParamError("move_away_release_fraction", "must be below 1 (a fraction of the force limit)")
     if s.no_data_end_timeout and s.no_data_end_timeout < s.wrench_timeout:

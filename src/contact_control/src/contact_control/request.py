@@ -33,6 +33,7 @@ from contact_control.axes import (
     EXCEEDED_STOP,
     LAW_COMPLIANT_MOVE,
     LAW_FOLLOWER,
+    LAW_FORCE_TRACKING,
     LAW_NAMES,
     LAW_NONE,
     LAW_SPRING,
@@ -166,6 +167,7 @@ def laws_fields(axis: int) -> dict[str, str]:
         "limit": f"{a}.force_limit",
         "travel": f"{a}.max_travel",
         "action": f"{a}.exceeded_action",
+        "target": f"{a}.target_force",
     }
 
 
@@ -183,22 +185,36 @@ def _axis_law(
     limits: RequestLimits,
     names: dict[str, str],
     action: int = EXCEEDED_STOP,
+    target: float | None = None,
 ) -> AxisLaw:
-    """One axis's law from its raw values, or a RequestError naming the field to set."""
+    """One axis's law from its raw values, or a RequestError naming the field to set.
+
+    `target` is the force tracking target; None: the message has no such field (ConfigureForceControl), so
+    force tracking is an unknown law type there.
+    """
     name = AXES[axis]
     law, b, k, v, limit, travel = fields
     angular = axis >= 3
     unit_f, unit_d, unit_v = ("Nm", "rad", "rad/s") if angular else ("N", "m", "m/s")
-    values = {"law": law, "b": b, "k": k, "v": v, "limit": limit, "travel": travel, "action": action}
+    values = {"law": law, "b": b, "k": k, "v": v, "limit": limit, "travel": travel, "action": action,
+              "target": target}
 
     def fail(code: int, what: str, key: str) -> RequestError:
         # The field to set and what it holds: "RX reads cart_impedance_params.damping.rotational.x; got 0.0"
         where = f"{name.upper()} reads {names[key]}; got {values[key]}"
         return RequestError(code, f"axis {name} ({LAW_NAMES.get(law, law)}): {what}; {where}", name)
 
+    if law == LAW_FORCE_TRACKING and target is None:
+        raise fail(
+            SET_DOF_FAILED,
+            "force tracking (4) is offered through compliant_control_msgs/ConfigureLaws only "
+            "(service configure_laws, field target_force)",
+            "law",
+        )
     if law not in LAW_NAMES:
-        raise fail(SET_DOF_FAILED, f"unknown law type {law} (0 none, 1 follower, 2 spring, 3 compliant move)",
-                   "law")
+        known = "0 none, 1 follower, 2 spring, 3 compliant move" + (", 4 force tracking" if target is not None
+                                                                     else "")
+        raise fail(SET_DOF_FAILED, f"unknown law type {law} ({known})", "law")
     if law == LAW_NONE:
         return AxisLaw()
     signed_limit = law == LAW_COMPLIANT_MOVE and v == 0.0  # its sign gives the direction
@@ -219,7 +235,7 @@ def _axis_law(
         )
     if limit == 0.0:
         action = EXCEEDED_STOP  # nothing to exceed
-    if law in (LAW_FOLLOWER, LAW_SPRING) and not (b > 0.0 and math.isfinite(b)):
+    if law in (LAW_FOLLOWER, LAW_SPRING, LAW_FORCE_TRACKING) and not (b > 0.0 and math.isfinite(b)):
         raise fail(SET_CARTESIAN_CONTROL_FAILED, "damping b must be finite and > 0", "b")
     if law == LAW_SPRING:
         if not (k > 0.0 and math.isfinite(k)):
@@ -229,6 +245,8 @@ def _axis_law(
         )
     if law == LAW_FOLLOWER:
         return AxisLaw(LAW_FOLLOWER, damping=b, force_limit=limit, max_travel=travel, exceeded_action=action)
+    if law == LAW_FORCE_TRACKING:
+        return _tracking_law(axis, b, v, limit, travel, action, float(target), limits, fail)
     # compliant move
     if not (b >= 0.0 and math.isfinite(b)):
         raise fail(SET_CARTESIAN_CONTROL_FAILED, "damping b must be finite, >= 0 (0: no force term)", "b")
@@ -271,6 +289,57 @@ def _axis_law(
         force_limit=limit,
         max_travel=travel,
         exceeded_action=action,
+    )
+
+
+def _tracking_law(
+    axis: int,
+    b: float,
+    v: float,
+    limit: float,
+    travel: float,
+    action: int,
+    target: float,
+    limits: RequestLimits,
+    fail: Any,
+) -> AxisLaw:
+    """The force tracking law of one axis (V = (F - target) / b), checked; `fail` builds the refusal."""
+    angular = axis >= 3
+    unit_f, unit_v = ("Nm", "rad/s") if angular else ("N", "m/s")
+    cap = limits.max_torque if angular else limits.max_force
+    if not math.isfinite(target):
+        raise fail(SET_CONTROL_FORCE_FAILED, f"target force must be finite {unit_f}", "target")
+    if cap is not None and abs(target) >= cap:
+        raise fail(SET_CONTROL_FORCE_FAILED, f"target force must be below the global limit {cap} {unit_f}",
+                   "target")
+    if limit > 0.0 and limit <= abs(target):
+        # The move would end the moment it arrived: a limit must leave room above the target.
+        raise fail(
+            SET_CONTROL_FORCE_FAILED,
+            f"force/torque limit must exceed |target_force| {abs(target):g} {unit_f} (0: no limit)",
+            "limit",
+        )
+    if not (v >= 0.0 and math.isfinite(v)):
+        raise fail(
+            SET_CARTESIAN_CONTROL_FAILED,
+            f"approach speed must be finite, >= 0 {unit_v} (the direction is the target force's: toward the "
+            "contact; 0: the node's default)",
+            "v",
+        )
+    if v == 0.0:
+        default = limits.default_angular_velocity if angular else limits.default_velocity
+        v = default if default is not None else 0.0
+    vmax = limits.max_angular_velocity if angular else limits.max_velocity
+    if vmax is not None and v > vmax:
+        raise fail(SET_CARTESIAN_CONTROL_FAILED, f"approach speed exceeds max velocity {vmax} {unit_v}", "v")
+    return AxisLaw(
+        LAW_FORCE_TRACKING,
+        damping=b,
+        velocity=v,
+        force_limit=limit,
+        max_travel=travel,
+        exceeded_action=action,
+        target=target,
     )
 
 
@@ -329,12 +398,12 @@ def validate_laws_request(req: Any, limits: RequestLimits | None = None) -> list
             a = getattr(req, name)
             numbers = (a.damping, a.stiffness, a.velocity, a.force_limit, a.max_travel)
             values = (int(a.law), *(float(x) for x in numbers))
-            raw.append((values, int(a.exceeded_action)))
+            raw.append((values, int(a.exceeded_action), float(getattr(a, "target_force", 0.0))))
     except (AttributeError, TypeError, ValueError) as err:
         raise RequestError(FAILURE, f"malformed ConfigureLaws request: {err}") from err
     laws = []
-    for axis, (values, action) in enumerate(raw):
-        law = _axis_law(axis, values, limits, laws_fields(axis), action)
+    for axis, (values, action, target) in enumerate(raw):
+        law = _axis_law(axis, values, limits, laws_fields(axis), action, target)
         if law.law and action != EXCEEDED_STOP and law.force_limit == 0.0:
             name = AXES[axis]
             raise RequestError(
@@ -382,6 +451,8 @@ def fill_request(req: Any, laws: Sequence[AxisLaw]) -> Any:
     """
     if len(laws) != 6:
         raise ValueError(f"need 6 laws (x, y, z, rx, ry, rz), got {len(laws)}")
+    if any(law.law == LAW_FORCE_TRACKING for law in laws):
+        raise ValueError("ConfigureForceControl has no force tracking law; use ConfigureLaws")
     p = req.cart_impedance_params
     for axis, law in enumerate(laws):
         c = AXES[axis][-1]
@@ -407,7 +478,10 @@ def _common_action(laws: Sequence[AxisLaw]) -> int:
 
 def empty_laws_request() -> SimpleNamespace:
     """A ConfigureLaws-shaped request of zeros (every axis NONE), for tests and Qt-free code."""
-    fields = ("law", "damping", "stiffness", "velocity", "force_limit", "max_travel", "exceeded_action")
+    fields = (
+        "law", "damping", "stiffness", "velocity", "force_limit", "max_travel", "exceeded_action",
+        "target_force",
+    )
     return SimpleNamespace(**{name: SimpleNamespace(**dict.fromkeys(fields, 0)) for name in AXES})
 
 
@@ -420,4 +494,5 @@ def fill_laws_request(req: Any, laws: Sequence[AxisLaw]) -> Any:
         a.law, a.exceeded_action = law.law, law.exceeded_action
         a.damping, a.stiffness, a.velocity = float(law.damping), float(law.stiffness), float(law.velocity)
         a.force_limit, a.max_travel = float(law.force_limit), float(law.max_travel)
+        a.target_force = float(law.target)
     return req

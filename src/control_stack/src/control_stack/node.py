@@ -43,6 +43,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         frame_source=jog.model_frame_pose,
         own_subscribers=int(same_topic),
     )
+    # jog_arm's contact guard on outside twists reads contact_control's compensated force in-process.
+    jog.use_contact_source(contact.contact_force)
 
     def on_lost(reason: str) -> None:
         contact.on_master_lost(reason)

@@ -12,7 +12,7 @@ import math
 import sys
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import pinocchio as pin
@@ -23,23 +23,30 @@ from compliant_common.master import MasterWatch
 from compliant_common.ros_time import JumpAwareClock, timer
 from compliant_common.runtime import tune_runtime
 from compliant_control_msgs.msg import JogStatus
-from geometry_msgs.msg import TwistStamped
+from geometry_msgs.msg import TwistStamped, WrenchStamped
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger, TriggerResponse
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
+from jog_arm.contact_guard import ContactGuard
 from jog_arm.jog_calcs import JogCalcs
 from jog_arm.kinematics import KinematicsError
 from jog_arm.settings import JogSettings, SettingsError
 from jog_arm.status import StatusCode
 from jog_arm.timing import CycleMonitor, next_fill_time
 
-__all__ = ["JogArmNode", "main", "start"]
+__all__ = ["ContactSource", "JogArmNode", "main", "start"]
+
+#: Returns the latest contact force on the tool: ((fx, fy, fz) [N], its frame, the time it was measured [s]),
+#: or None when there is none yet.
+ContactSource = Callable[[], "tuple[Sequence[float], str, float] | None"]
 
 _TF_ERRORS = (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException)
 _WARN_PERIOD = 2.0  # [s] throttle of repeated warnings
 NOTE_SHOWN_FOR = 1.0  # [s] a clock jump stays on ~status at least this long
+# While the contact guard cuts an outside twist, ~status says so instead of these (it is why the arm stops).
+_GUARD_OUTRANKS = (StatusCode.NO_WARNING, StatusCode.JOINT_VELOCITY_SCALED, StatusCode.STALE_COMMAND)
 
 
 class JogArmNode:
@@ -107,6 +114,25 @@ class JogArmNode:
             rospy.Subscriber(settings.joint_topic, JointState, self._on_joints, **fast),
             rospy.Subscriber(settings.cmd_in_topic, TwistStamped, self._on_twist, **fast),
         ]
+        # Contact-force guard on outside twists: the force comes from a topic (two nodes) until a controller
+        # in the same process provides it (`use_contact_source`, control_stack).
+        self._guard: ContactGuard | None = None
+        self._contact: tuple[Sequence[float], str, float] | None = None
+        self._contact_source: ContactSource = lambda: self._contact
+        self._guard_note = ""
+        self._guard_code = False  # the guard acted on the current command
+        self._guard_sub: rospy.Subscriber | None = None
+        if settings.contact_guard_enabled:
+            self._guard = ContactGuard(
+                settings.contact_guard_max_force,
+                settings.contact_guard_slow_force,
+                settings.contact_guard_slow_speed,
+                settings.contact_guard_timeout,
+                settings.contact_guard_relief_speed,
+            )
+            self._guard_sub = rospy.Subscriber(
+                settings.contact_guard_wrench_topic, WrenchStamped, self._on_contact_wrench, **fast
+            )
         self._closed = False
         if settings.publish_on_command:  # twists run the cycles; a timer would wake 1/pub_period times a s
             self._timer: rospy.Timer | None = None
@@ -145,10 +171,53 @@ class JogArmNode:
         self.accept_twist(msg)
 
     def accept_twist(self, msg: TwistStamped) -> None:
-        """A velocity command from the topic."""
+        """A velocity command from the topic (an outside source: it goes through the contact guard)."""
         lin, ang = msg.twist.linear, msg.twist.angular
         twist = (lin.x, lin.y, lin.z, ang.x, ang.y, ang.z)
-        self.accept_velocity(twist, msg.header.frame_id, self._now(), from_topic=True)
+        now = self._now()
+        if self._guard is not None:
+            twist = self._guarded(twist, msg.header.frame_id.lstrip("/") or self._s.default_cmd_frame, now)
+        self.accept_velocity(twist, msg.header.frame_id, now, from_topic=True)
+
+    # --- contact-force guard ---
+    def use_contact_source(self, source: ContactSource) -> None:
+        """Takes the contact force from a controller in this process instead of the topic (control_stack)."""
+        self._contact_source = source
+        if self._guard_sub is not None:
+            self._guard_sub.unregister()
+            self._guard_sub = None
+
+    def _on_contact_wrench(self, msg: WrenchStamped) -> None:
+        f = msg.wrench.force
+        self._contact = ((f.x, f.y, f.z), msg.header.frame_id.lstrip("/"), self._now())
+
+    def _guarded(self, twist: Sequence[float], frame: str, now: float) -> Sequence[float]:
+        """The twist the contact guard lets through; remembers why for ~status and logs changes."""
+        assert self._guard is not None
+        contact = self._contact_source()
+        force, age = None, 0.0
+        if contact is not None:
+            raw, force_frame, measured = contact
+            age = now - measured
+            force = tuple(raw)
+            if force_frame and force_frame != frame:
+                pose = self.model_frame_pose_or_none(force_frame, frame)
+                if pose is None:  # cannot say which way is into the contact: treat like no fresh force
+                    force, age = (math.nan,) * 3, 0.0
+                else:
+                    force = tuple(sum(pose[r][c] * raw[c] for c in range(3)) for r in range(3))
+        result = self._guard.limit(twist, force, age)
+        if result.message != self._guard_note and result.acted:
+            rospy.logwarn_throttle(_WARN_PERIOD, f"jog_arm_server: {result.message}")
+        self._guard_note, self._guard_code = result.message, result.acted
+        return result.twist
+
+    def model_frame_pose_or_none(self, frame: str, relative_to: str) -> list[list[float]] | None:
+        """`model_frame_pose`, or None also before the first joint state."""
+        try:
+            return self.model_frame_pose(frame, relative_to)
+        except LookupError:
+            return None
 
     def accept_velocity(
         self, twist: Sequence[float], frame: str, now: float, from_topic: bool = False
@@ -252,6 +321,8 @@ class JogArmNode:
                     points = [(out.positions, out.velocities, self._s.pub_period)]
             status, message = out.status, out.message
             condition, scale = out.condition_number, out.speed_scale
+            if self._guard_code and self._from_topic and status in _GUARD_OUTRANKS:
+                status, message = StatusCode.CONTACT_GUARD, self._guard_note
         if publish:
             self._publish_command(points)
         if self._status_pub.get_num_connections() > 0:  # nobody listening: save the cycle the work
@@ -295,7 +366,7 @@ class JogArmNode:
     def _log_status(status: StatusCode, message: str) -> None:
         if status in (StatusCode.NO_WARNING, StatusCode.STALE_COMMAND, StatusCode.JOINT_VELOCITY_SCALED):
             rospy.logdebug("jog_arm_server: %s: %s", status.name, message)
-        elif status in (StatusCode.PAUSED, StatusCode.NO_JOINT_STATE):
+        elif status in (StatusCode.PAUSED, StatusCode.NO_JOINT_STATE, StatusCode.CONTACT_GUARD):
             rospy.loginfo("jog_arm_server: %s: %s", status.name, message)
         else:
             rospy.logwarn("jog_arm_server: %s: %s", status.name, message)

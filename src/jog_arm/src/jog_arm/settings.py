@@ -108,6 +108,14 @@ class JogSettings:
     max_tracking_error: float = 0.2  # [rad] re-sync to the measured state beyond this; 0 = never
     publish_on_command: bool = False  # also run a cycle when a twist arrives (lowest latency)
     publish_synchronously: bool = False  # write the command socket in the cycle's thread (no sender thread)
+    # contact-force guard on twists from outside sources (keyboard, rostopic pub; see contact_guard.py)
+    contact_guard_enabled: bool = True
+    contact_guard_max_force: float = 20.0  # [N] motion into the contact stops at this contact force
+    contact_guard_slow_force: float = 2.0  # [N] motion into the contact is slowed from this force on
+    contact_guard_slow_speed: float = 0.01  # [m/s] into-contact speed cap at slow_force (0 at max_force)
+    contact_guard_timeout: float = 0.25  # [s] an older contact force stops outside twists
+    contact_guard_relief_speed: float = 0.005  # [m/s] at max_force a push into the contact backs off at this
+    contact_guard_wrench_topic: str = "contact_control_node/contact_wrench"  # two-node layout's force input
 
     @classmethod
     def from_params(cls, params: Mapping[str, Any], prefix: str = "jog_arm_server/") -> JogSettings:
@@ -224,6 +232,14 @@ class JogSettings:
             raise SettingsError(
                 f"{prefix}low_pass_filter_coeff must be >= 1 (smaller values make the filter ring), "
                 f"got {self.low_pass_filter_coeff}"
+            )
+        for name in ("contact_guard_max_force", "contact_guard_slow_speed", "contact_guard_timeout",
+                     "contact_guard_relief_speed"):
+            positive(name)
+        if not 0.0 <= self.contact_guard_slow_force < self.contact_guard_max_force:
+            raise SettingsError(
+                f"{prefix}contact_guard_slow_force must be >= 0 and below contact_guard_max_force "
+                f"({self.contact_guard_max_force} N), got {self.contact_guard_slow_force}"
             )
         if self.simu_points < 1:
             raise SettingsError(f"{prefix}simu_points must be >= 1, got {self.simu_points}")

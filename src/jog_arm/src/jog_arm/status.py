@@ -21,3 +21,4 @@ class StatusCode(IntEnum):
     PAUSED = 8
     NO_JOINT_STATE = 9
     STALE_JOINT_STATE = 10
+    CONTACT_GUARD = 11

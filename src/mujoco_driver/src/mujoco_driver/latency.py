@@ -39,8 +39,11 @@ class LatencyProbe:
         """A wrench is being published at `t` (monotonic clock [s])."""
         pending = self._pending
         pending.append(t)
-        while pending[0] < t - self.horizon:
-            pending.popleft()
+        try:
+            while pending[0] < t - self.horizon:
+                pending.popleft()
+        except IndexError:  # command_received (the subscriber thread) emptied it meanwhile: nothing to drop
+            pass
 
     def command_received(self, t: float, wall: float) -> None:
         """A joint command arrived at `t` (same clock as `wrench_sent`), `wall` being time.time() then."""

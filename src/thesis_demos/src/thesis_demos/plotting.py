@@ -35,6 +35,13 @@ def plot(scenario: Scenario, rec: Recording, verdict: Verdict, path: str) -> Non
         tv, v = _velocity(rec.pose_t, rec.pose[:, i])
         ax_v.plot(tv, v, alpha=0.7, label=f"v{axis} measured")
         ax_p.plot(rec.pose_t, (rec.pose[:, i] - rec.pose[0, i]) * 1e3, label=f"{axis} - {axis}0")
+    if scenario.follow_up is not None:
+        # The target band and the time the follow-up laws (surface following: the X move) were sent.
+        up = scenario.follow_up
+        ax_f.axhspan(up.target - up.tolerance, up.target + up.tolerance, color="green", alpha=0.1)
+        if rec.follow_up_time is not None:
+            for ax in (ax_f, ax_v, ax_p):
+                ax.axvline(rec.follow_up_time, color="green", linestyle=":", linewidth=1)
     for ax in (ax_f, ax_v, ax_p):
         for push in scenario.pushes:
             ax.axvspan(push.start, push.end, color="orange", alpha=0.15)

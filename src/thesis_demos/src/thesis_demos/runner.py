@@ -1,7 +1,8 @@
 """Runs the demonstrations against a live stack, through its public ROS interface only.
 
 Services and topics used (all names are parameters of `run_demos`, defaults as the robot packages
-wire them): contact_control's `configure_cartesian_impedance`, `~tare`, `~stop`, `~reset`, `~status`;
+wire them): contact_control's `configure_cartesian_impedance` (`configure_laws` for force tracking),
+`~tare`, `~stop`, `~reset`, `~status`;
 the MuJoCo driver's `~push`, `~reset`, `~eef_pose` and the wrist `wrench` topic; tf for the sensor's
 orientation.
 """
@@ -17,14 +18,16 @@ import rospy
 import tf2_ros
 from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
 from compliant_control_msgs.msg import ContactControlStatus
-from compliant_control_msgs.srv import PushEEF, PushEEFRequest
+from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsRequest, PushEEF, PushEEFRequest
 from geometry_msgs.msg import PoseStamped, WrenchStamped
 from std_srvs.srv import Trigger
 
 from thesis_demos.analysis import Recording
-from thesis_demos.scenarios import AXES, Scenario
+from thesis_demos.scenarios import AXES, AxisLaw, Scenario
 
-__all__ = ["DemoRunner", "Names", "build_request"]
+__all__ = ["DemoRunner", "Names", "build_laws_request", "build_request"]
+
+_ACTIONS = {"stop": 0, "move_away": 1, "gravity_compensation": 2}  # compliant_control_msgs/AxisLaw ACTION_*
 
 
 @dataclass(frozen=True)
@@ -32,6 +35,7 @@ class Names:
     """Where the stack's interfaces live."""
 
     configure: str = "/configure_cartesian_impedance"
+    configure_laws: str = "/configure_laws"
     contact_control: str = "/contact_control_node"
     driver: str = "/mujoco_driver"
     wrench: str = "/wrench"
@@ -66,6 +70,24 @@ def build_request(scenario: Scenario) -> ConfigureForceControlRequest:
     if scenario.exceeded_action not in ("stop", "move_away", "gravity_compensation"):
         raise ValueError(f"{scenario.name}: unknown exceeded_action {scenario.exceeded_action!r}")
     setattr(action, scenario.exceeded_action, True)
+    return req
+
+
+def build_laws_request(laws: dict[str, AxisLaw], exceeded_action: str = "stop") -> ConfigureLawsRequest:
+    """The compliant_control_msgs/ConfigureLaws request for laws per axis (force tracking needs it).
+
+    `exceeded_action` applies to every axis with a force (torque) limit, as in the original message.
+    """
+    if exceeded_action not in _ACTIONS:
+        raise ValueError(f"unknown exceeded_action {exceeded_action!r}")
+    req = ConfigureLawsRequest()
+    for axis, law in laws.items():
+        a = getattr(req, axis)
+        rotational = axis.startswith("r")
+        a.law, a.damping, a.stiffness, a.velocity = law.law, law.damping, law.stiffness, law.velocity
+        a.force_limit = law.torque_limit if rotational else law.force_limit
+        a.max_travel, a.target_force = law.max_travel, law.target_force
+        a.exceeded_action = _ACTIONS[exceeded_action] if a.force_limit > 0.0 else 0
     return req
 
 
@@ -104,6 +126,7 @@ class DemoRunner:
         cc, drv = names.contact_control, names.driver
         for service in (
             names.configure,
+            names.configure_laws,
             f"{cc}/tare",
             f"{cc}/stop",
             f"{cc}/reset",
@@ -112,6 +135,7 @@ class DemoRunner:
         ):
             rospy.wait_for_service(service, timeout=timeout)
         self._configure = rospy.ServiceProxy(names.configure, ConfigureForceControl)
+        self._configure_laws = rospy.ServiceProxy(names.configure_laws, ConfigureLaws)
         self._tare = rospy.ServiceProxy(f"{cc}/tare", Trigger)
         self._stop = rospy.ServiceProxy(f"{cc}/stop", Trigger)
         self._reset_safety = rospy.ServiceProxy(f"{cc}/reset", Trigger)
@@ -217,14 +241,23 @@ class DemoRunner:
             series.clear()
         time.sleep(0.3)  # a baseline of the tared sensor before the laws start (plotted, not timed)
         baseline_t = rospy.get_time()
-        response = self._configure(build_request(scenario))
-        if not response.success:
-            raise RuntimeError(f"{scenario.name}: contact_control refused the request (see its ~status)")
+        self._send(scenario, scenario.laws)
         t0 = rospy.get_time()
         pushes = sorted(scenario.pushes, key=lambda p: p.start)
         end_time = None
+        follow_up, follow_up_time, settled_since = scenario.follow_up, None, None
         while not rospy.is_shutdown():
             now = rospy.get_time() - t0
+            if follow_up is not None and follow_up_time is None:
+                # Sent once the force has stayed near its target for follow_up.hold (pressing on the block).
+                force = self._force(follow_up.axis)
+                if force is not None and abs(force - follow_up.target) <= follow_up.tolerance:
+                    settled_since = now if settled_since is None else settled_since
+                    if now - settled_since >= follow_up.hold:
+                        self._send(scenario, follow_up.laws)
+                        follow_up_time = rospy.get_time() - t0
+                else:
+                    settled_since = None
             while pushes and now >= pushes[0].start:
                 push = pushes.pop(0)
                 req = PushEEFRequest(duration=push.duration)
@@ -240,7 +273,26 @@ class DemoRunner:
             time.sleep(0.005)
         _, ends = self._move_state()
         self._stop()
-        return self._recording(t0, baseline_t, ends, end_time)
+        recording = self._recording(t0, baseline_t, ends, end_time)
+        recording.follow_up_time = follow_up_time
+        return recording
+
+    def _send(self, scenario: Scenario, laws: dict[str, AxisLaw]) -> None:
+        """Sends laws through configure_laws when the scenario needs it, else the original service."""
+        if scenario.uses_laws_service:
+            answer = self._configure_laws(build_laws_request(laws, scenario.exceeded_action))
+            if not answer.success:
+                raise RuntimeError(f"{scenario.name}: contact_control refused the laws: {answer.message}")
+            return
+        response = self._configure(build_request(scenario))
+        if not response.success:
+            raise RuntimeError(f"{scenario.name}: contact_control refused the request (see its ~status)")
+
+    def _force(self, axis: str) -> float | None:
+        """The controller's latest force [N] along `axis` (x, y or z; control frame), None before a status."""
+        with self._status_lock:
+            status = self._last_status
+        return None if status is None else getattr(status.wrench.force, axis)
 
     def _recording(
         self, t0: float, baseline_t: float, ends: dict[str, int], end_time: float | None

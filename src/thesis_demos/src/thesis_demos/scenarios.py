@@ -1,4 +1,4 @@
-"""The four thesis demonstrations as data: laws per axis, simulated pushes, what to judge.
+"""The four thesis demonstrations and a fifth (surface following) as data: laws, pushes, what to judge.
 
 Pure: no rospy. Forces are in the robot's base frame [N]; velocities [m/s]; distances [m].
 """
@@ -7,11 +7,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-__all__ = ["SCENARIOS", "AxisLaw", "Push", "Scenario", "by_name"]
+__all__ = ["SCENARIOS", "AxisLaw", "FollowUp", "Push", "Scenario", "by_name"]
 
 AXES = ("x", "y", "z", "rx", "ry", "rz")
 # cartesian_impedance_msgs/ControlLaw
 NONE, FOLLOWER, SPRING, COMPLIANT_MOVE = 0, 1, 2, 3
+# compliant_control_msgs/AxisLaw: offered through configure_laws only
+FORCE_TRACKING = 4
 
 
 @dataclass(frozen=True)
@@ -25,6 +27,7 @@ class AxisLaw:
     force_limit: float = 0.0  # [N]
     torque_limit: float = 0.0  # [Nm], sent as max_ctrl_force.set.torque on the same axis letter
     max_travel: float = 0.0  # [m]
+    target_force: float = 0.0  # [N] force tracking's target, as the sensor reads the contact (table below: +)
 
 
 @dataclass(frozen=True)
@@ -38,6 +41,20 @@ class Push:
     @property
     def end(self) -> float:
         return self.start + self.duration
+
+
+@dataclass(frozen=True)
+class FollowUp:
+    """Laws sent (for every axis, replacing the first ones bumplessly) once a force has settled.
+
+    Sent when the controller's force on `axis` stayed within `tolerance` [N] of `target` [N] for `hold` [s].
+    """
+
+    laws: dict[str, AxisLaw]
+    axis: str
+    target: float
+    tolerance: float
+    hold: float = 0.5
 
 
 @dataclass(frozen=True)
@@ -55,6 +72,13 @@ class Scenario:
     # max_ctrl_force.exceeded_action of the request (one for all axes with a force limit): stop, move_away or
     # gravity_compensation.
     exceeded_action: str = "stop"
+    follow_up: FollowUp | None = None  # a second request during the run (surface following: the X move)
+
+    @property
+    def uses_laws_service(self) -> bool:
+        """Force tracking exists only in compliant_control_msgs/ConfigureLaws (configure_laws)."""
+        laws = list(self.laws.values()) + (list(self.follow_up.laws.values()) if self.follow_up else [])
+        return any(law.law == FORCE_TRACKING for law in laws)
 
 
 # Thesis section 6.4, with the numbers it gives. Where it is silent: pushes of 5 N (follower) and
@@ -116,6 +140,54 @@ SCENARIOS: tuple[Scenario, ...] = (
         duration=9.0,
         end_when_move_ends=True,
         controlled=("x", "z"),
+    ),
+)
+
+
+# Surface following (the fifth demonstration, not in the thesis): Z presses on the obstacle block's top with a
+# set force while X moves over it. Named here so they can later come from the robot package's configuration.
+# The block is 15 cm wide with the tool tip over its centre at the start pose (both robots' sim.yaml), and the
+# tool is a 3 cm radius cylinder: 4 cm of travel along -X keeps the whole tool face on the block.
+SURFACE_TARGET_FORCE = 10.0  # [N] pressing down: the block pushes the tool up (+Z) with this
+SURFACE_TOLERANCE = 1.5  # [N] the mean over the travel must be this close to the target
+SURFACE_DAMPING = 2000.0  # [N/(m/s)] b against ~20 N/mm of a stiff arm on a block (contact_control README)
+# [m/s] down onto the block until the force reaches half the target: touching at 0.01 m/s overshot to 21 N on
+# a simulated arm (the filtered force and the arm lag ~70 ms behind the contact) and tripped the 25 N limit.
+SURFACE_APPROACH_SPEED = 0.005
+SURFACE_FORCE_LIMIT = 20.0  # [N] ends the press (move_away) well under the 25 N global limit
+SURFACE_TRAVEL = 0.04  # [m] along X over the block's top
+SURFACE_VELOCITY = -0.01  # [m/s] along X (toward the base: clear on both robots, see hybrid)
+SURFACE_SETTLE = 0.5  # [s] after X starts, left out of the figures (X speeding up, friction building up)
+
+_PRESS = AxisLaw(
+    FORCE_TRACKING,
+    damping=SURFACE_DAMPING,
+    velocity=SURFACE_APPROACH_SPEED,
+    force_limit=SURFACE_FORCE_LIMIT,
+    target_force=SURFACE_TARGET_FORCE,
+)
+
+SCENARIOS = (
+    *SCENARIOS,
+    Scenario(
+        name="surface_following",
+        title=f"Surface following: Z tracks {SURFACE_TARGET_FORCE:g} N on the block's top while X moves "
+        f"{SURFACE_TRAVEL * 100:g} cm",
+        laws={"z": _PRESS},
+        duration=25.0,
+        end_when_move_ends=True,
+        settle=0.5,
+        controlled=("x", "z"),
+        exceeded_action="move_away",
+        follow_up=FollowUp(
+            laws={
+                "z": _PRESS,
+                "x": AxisLaw(COMPLIANT_MOVE, velocity=SURFACE_VELOCITY, max_travel=SURFACE_TRAVEL),
+            },
+            axis="z",
+            target=SURFACE_TARGET_FORCE,
+            tolerance=0.5,
+        ),
     ),
 )
 
