@@ -299,6 +299,8 @@ class JogArmNode:
 
     def _cycle(self, now: float) -> None:
         """One control cycle: compute, publish the joint command and the status."""
+        if self._closed:  # shutting down: a last twist from contact_control in this process comes too late
+            return
         # Throttled here: rospy's logwarn_throttle inspects the caller's source file (~100 us) on every call.
         if self._cycles.tick(now) and now >= self._next_missed_warning:
             self._next_missed_warning = now + 10.0
