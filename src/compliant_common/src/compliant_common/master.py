@@ -1,4 +1,6 @@
-"""ROS master loss and return: detected within ~1 s, then every registration of this process restored.
+"""ROS master loss and return: a dead master is seen within one poll (0.5 s), one that stops answering after
+three unanswered polls (~4.5 s: a master merely slow on a loaded machine must not stop the arm); when it
+answers again every registration of this process is restored.
 
 rospy registers a node's topics, services and parameters once, at start; a roscore that restarts comes
 back empty, and nobody finds the node again although its existing connections still carry data. This
@@ -23,6 +25,9 @@ import rospy
 from rospy.impl import registration
 
 __all__ = ["MasterWatch"]
+
+PROBE_TIMEOUT = 1.0  # [s] for the master to answer one poll
+SLOW_POLLS = 3  # unanswered polls in a row that count as a lost master (a refused connection counts at once)
 
 
 def _reg_manager() -> registration.RegManager | None:
@@ -84,19 +89,24 @@ class MasterWatch:
 
     def _proxy(self) -> Any:
         """The master's XML-RPC API (Any: its answers are untyped (code, message, value) triples)."""
-        return xmlrpc.client.ServerProxy(self._uri, transport=_TimeoutTransport(max(self._period, 0.2)))
+        return xmlrpc.client.ServerProxy(self._uri, transport=_TimeoutTransport(PROBE_TIMEOUT))
 
     def _run(self) -> None:
+        slow = 0  # polls in a row the master did not answer in time
         while not (self._closed or rospy.is_shutdown()):
             try:
                 code, msg, pid = self._proxy().getPid(self._caller)
                 if code != 1:
                     raise OSError(msg)
             except (OSError, xmlrpc.client.Error, http.client.HTTPException) as err:
-                if not self.lost:
+                # Refused: nothing listens on the port, the master is gone. A timeout may be a master busy on
+                # a loaded machine: only several in a row count, so a slow answer never stops a move.
+                slow = 0 if isinstance(err, ConnectionRefusedError) else slow + 1
+                if not self.lost and (slow == 0 or slow >= SLOW_POLLS):
                     self.lost = True
                     self._on_lost(f"ROS master {self._uri} unreachable ({err})")
             else:
+                slow = 0
                 if self.lost or (self._pid is not None and pid != self._pid):
                     if self._restore():
                         self.lost = False
