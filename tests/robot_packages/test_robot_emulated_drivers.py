@@ -38,10 +38,10 @@ from std_srvs.srv import Trigger
 # What a user on the real cell has: the driver's names (from the real drivers' documentation).
 CELLS = {
     "ur5_custom": dict(profile="ur_robot_driver", base="base_link", joints="/joint_states", wrench="/wrench",
-                       frame="tool0_controller"),
+                       frame="tool0_controller", rate=125.0),
     "panda_custom": dict(profile="franka_ros", base="panda_link0",
                          joints="/franka_state_controller/joint_states",
-                         wrench="/franka_state_controller/F_ext", frame="panda_K"),
+                         wrench="/franka_state_controller/F_ext", frame="panda_K", rate=30.0),
 }
 
 
@@ -130,6 +130,12 @@ def test_hardware_launch_runs_unchanged_against_the_emulated_driver(ros_node, ro
         try:
             pose.wait_for(1, timeout=20)
             cc_status.wait_for(1, timeout=20)
+            # The driver's rate, from the stamps (the real drivers' defaults: CB3 125 Hz, franka 30 Hz).
+            wrenches = Collector(cell["wrench"], WrenchStamped)
+            wrenches.wait_for(40, timeout=10)
+            wrenches.close()
+            stamps = np.array([m.header.stamp.to_sec() for m in wrenches.msgs])
+            assert np.median(np.diff(stamps)) == pytest.approx(1.0 / cell["rate"], rel=0.15)
             wait_until(lambda: twist_pub.get_num_connections() > 0, 10, "jog_arm to subscribe to its input")
             list_controllers = rospy.ServiceProxy("/controller_manager/list_controllers", ListControllers)
             states = {c.name: c.state for c in list_controllers().controller}

@@ -79,7 +79,8 @@ class MujocoDriverNode:
         # Steps per publication; fractional for a profile's rate (30 Hz on 2 ms steps), exact on average.
         self._publish_every = (profile.publish_steps(sim.dt) if profile is not None
                                else s.publish_every(sim.dt))
-        self._pose_every = s.eef_pose_every(sim.dt)
+        # ~eef_pose every this many state publications (at a profile's rate, not the settings' period).
+        self._pose_every = max(1, round(s.eef_pose_period / (self._publish_every * sim.dt)))
         self._pose_countdown = 1
         self._last_velocity_command = -math.inf  # [s of sim time]
         self._velocity_active = False
