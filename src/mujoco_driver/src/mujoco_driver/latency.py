@@ -39,8 +39,13 @@ class LatencyProbe:
         """A wrench is being published at `t` (monotonic clock [s])."""
         pending = self._pending
         pending.append(t)
-        while pending[0] < t - self.horizon:
-            pending.popleft()
+        # command_received (another thread) may empty the deque between these lines: each step is atomic,
+        # the check and the pop together are not (an IndexError here killed the driver under load).
+        try:
+            while pending[0] < t - self.horizon:
+                pending.popleft()
+        except IndexError:
+            pass
 
     def command_received(self, t: float, wall: float) -> None:
         """A joint command arrived at `t` (same clock as `wrench_sent`), `wall` being time.time() then."""
