@@ -145,6 +145,7 @@ def test_hardware_launch_runs_unchanged_against_the_emulated_driver(ros_node, ro
                 assert rospy.wait_for_message("/speed_scaling_factor", Float64, timeout=5).data == 1.0
                 f = wrench.wrench.force
                 assert np.linalg.norm([f.x, f.y, f.z]) < 0.5, f"payload not compensated: {f}"
+                assert rospy.ServiceProxy("/ur_hardware_interface/zero_ftsensor", Trigger)().success
                 assert states["scaled_pos_joint_traj_controller"] == "running"
                 assert states["joint_group_vel_controller"] == "initialized"
                 # jog_arm's velocity commands go to a controller that is not running: the arm stays put.
