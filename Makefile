@@ -2,6 +2,7 @@
 SHELL := /bin/bash
 .SHELLFLAGS := -o pipefail -c
 ROBOT ?= ur5
+DRIVER ?=
 ENV := scripts/with_env
 PYTEST_ARGS ?=
 
@@ -21,7 +22,7 @@ lint: build
 	@$(ENV) catkin_lint -W2 --strict --offline src 2>&1 | grep -v rosdep
 
 demo: build
-	@$(ENV) python scripts/demo --robot $(ROBOT)
+	@$(ENV) python scripts/demo --robot $(ROBOT) $(if $(DRIVER),--driver $(DRIVER))
 
 bench: build
 	@$(ENV) python scripts/bench_contact_control

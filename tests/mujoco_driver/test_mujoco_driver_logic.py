@@ -125,6 +125,23 @@ def test_latency_probe_pairs_each_wrench_with_the_next_command():
     assert probe.take() == []
 
 
+def test_latency_probe_survives_a_command_emptying_it_between_append_and_trim():
+    """A command arriving in the subscriber thread right after the loop's append empties the deque; the loop
+    then looked at pending[0] and died with an IndexError (the driver node with it, in a demo run)."""
+    import collections
+
+    probe = LatencyProbe(horizon=0.1)
+
+    class Racy(collections.deque):
+        def append(self, value):
+            super().append(value)
+            probe.command_received(value + 0.0001, wall=1.0)  # the other thread, at the worst moment
+
+    probe._pending = Racy()
+    probe.wrench_sent(1.0)
+    assert probe.take() == pytest.approx([1.0, 0.0001])
+
+
 def test_latency_probe_counts_a_late_command_against_every_wrench_it_was_late_for():
     probe = LatencyProbe(horizon=0.1)
     for t in (1.000, 1.002, 1.004):

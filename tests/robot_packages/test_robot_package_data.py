@@ -29,7 +29,9 @@ OWN_LAUNCH_FILES = sorted(
     [p for pkg in (*ROBOTS, "mujoco_driver") for p in (ROOT / "src" / pkg / "launch").rglob("*.launch*")]
 )
 # Frames a real driver provides through tf, not the URDF (franka_state_controller's EE frame).
-EXTERNAL_FRAMES = {"panda_EE", "panda_K"}
+# Frames the real drivers publish on tf themselves, not in any URDF (franka_state_controller: NE, EE, K;
+# ur_robot_driver: base -> tool0_controller); the emulated drivers publish them the same way.
+EXTERNAL_FRAMES = {"panda_NE", "panda_EE", "panda_K", "tool0_controller"}
 # Demo motions of the tool tip from the start pose (the hybrid demo's 0.30 m along -X, pushes of a few cm).
 DEMO_OFFSETS = [(-0.30, 0, 0), (0.05, 0, 0), (0, 0.05, 0), (0, -0.05, 0), (0, 0, 0.05), (0, 0, -0.05)]
 

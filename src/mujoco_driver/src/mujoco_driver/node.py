@@ -8,7 +8,9 @@ Messages and arrays are allocated once; the loop fills them in place.
 
 from __future__ import annotations
 
+import dataclasses
 import faulthandler
+import functools
 import math
 import os
 import signal
@@ -23,19 +25,22 @@ import rospy.impl.simtime as simtime
 from compliant_common.master import MasterWatch
 from compliant_common.runtime import tune_runtime
 from compliant_control_msgs.srv import PushEEF, PushEEFResponse
-from geometry_msgs.msg import PoseStamped, WrenchStamped
+from geometry_msgs.msg import PoseStamped, TransformStamped, WrenchStamped
 from rosgraph_msgs.msg import Clock
 from rospy.rostime import _set_rostime
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64, Float64MultiArray, MultiArrayDimension
+from std_msgs.msg import Float64, Float64MultiArray, MultiArrayDimension, String
 from std_srvs.srv import Trigger, TriggerResponse
+from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectory
 
 from mujoco_driver.commands import trajectory_points, velocity_vector
 from mujoco_driver.config import ConfigError, SceneConfig
+from mujoco_driver.emulation import DriverEmulation
 from mujoco_driver.latency import LatencyProbe
 from mujoco_driver.pacing import Pacer, RtfMeter, TrailingPublication
 from mujoco_driver.params import DriverSettings, ParamError, load_scene, urdf_root_link
+from mujoco_driver.profiles import DriverProfile, ProfileError, load_profile
 from mujoco_driver.scene import SceneError
 from mujoco_driver.sim import CommandError, Simulation
 
@@ -53,12 +58,15 @@ class MujocoDriverNode:
         settings: The validated node parameters.
         urdf: The robot description.
         scene_cfg: The scene settings.
+        profile: A real driver's interface to speak (None: this driver's own, see the README).
 
     Raises:
         ConfigError, SceneError: If the URDF and the scene do not make a simulation.
+        ProfileError: If the profile names links the description lacks.
     """
 
-    def __init__(self, settings: DriverSettings, urdf: str, scene_cfg: SceneConfig) -> None:
+    def __init__(self, settings: DriverSettings, urdf: str, scene_cfg: SceneConfig,
+                 profile: DriverProfile | None = None) -> None:
         self._s = s = settings
         self._sim = sim = Simulation(urdf, scene_cfg)
         for entry in sim.scene.geometry:  # meshes converted or replaced for MuJoCo: say so, per link
@@ -67,8 +75,12 @@ class MujocoDriverNode:
         self._lock = threading.Lock()
         self._base_frame = s.base_frame or urdf_root_link(urdf)
         self._clock_offset = 0.0  # simulated time before the last ~reset, so /clock never runs backwards
-        self._publish_every = s.publish_every(sim.dt)
-        self._pose_every = s.eef_pose_every(sim.dt)
+        self._emu = DriverEmulation(sim, profile) if profile is not None else None
+        # Steps per publication; fractional for a profile's rate (30 Hz on 2 ms steps), exact on average.
+        self._publish_every = (profile.publish_steps(sim.dt) if profile is not None
+                               else s.publish_every(sim.dt))
+        # ~eef_pose every this many state publications (at a profile's rate, not the settings' period).
+        self._pose_every = max(1, round(s.eef_pose_period / (self._publish_every * sim.dt)))
         self._pose_countdown = 1
         self._last_velocity_command = -math.inf  # [s of sim time]
         self._velocity_active = False
@@ -116,18 +128,32 @@ class MujocoDriverNode:
         if self._clock_pub is not None and getattr(simtime, "_clock_sub", None) is not None:
             simtime._clock_sub.unregister()  # see _publish_clock
             simtime._clock_sub = None
-        self._subs = [
-            rospy.Subscriber(s.trajectory_command_topic, JointTrajectory, self._on_trajectory,
-                             queue_size=1, tcp_nodelay=True),
-            rospy.Subscriber(s.velocity_command_topic, Float64MultiArray, self._on_velocity,
-                             queue_size=1, tcp_nodelay=True),
-            rospy.Subscriber("~push_wrench", WrenchStamped, self._on_push_wrench, queue_size=1,
-                             tcp_nodelay=True),
-        ]
+        if self._emu is None:
+            self._subs = [
+                rospy.Subscriber(s.trajectory_command_topic, JointTrajectory, self._on_trajectory,
+                                 queue_size=1, tcp_nodelay=True),
+                rospy.Subscriber(s.velocity_command_topic, Float64MultiArray, self._on_velocity,
+                                 queue_size=1, tcp_nodelay=True),
+            ]
+        else:  # one command topic per controller, as ros_control: <controller>/command
+            kinds = {"trajectory": (JointTrajectory, self._on_trajectory),
+                     "velocity": (Float64MultiArray, self._on_velocity)}
+            self._subs = [
+                rospy.Subscriber(f"{c.name}/command", kinds[c.command][0],
+                                 functools.partial(kinds[c.command][1], controller=c.name),
+                                 queue_size=1, tcp_nodelay=True)
+                for c in profile.controllers if c.command != "none"
+            ]
+        self._subs.append(rospy.Subscriber("~push_wrench", WrenchStamped, self._on_push_wrench, queue_size=1,
+                                           tcp_nodelay=True))
         self._services = [
             rospy.Service("~push", PushEEF, self._on_push),
             rospy.Service("~reset", Trigger, self._on_reset),
         ]
+        self._tf_pub = self._scaling_pub = self._mode_pub = None
+        self._recovery = None
+        if self._emu is not None:
+            self._setup_emulation(profile, publisher)
         self._viewer = self._open_viewer() if s.viewer else None
         self._warned: dict[str, int] = {}
         self._last_warning: dict[str, float] = {}
@@ -176,18 +202,21 @@ class MujocoDriverNode:
             publish = countdown <= 0 and not catching_up
             if state.due(now, state_changes=publish):
                 self._publish_state()
+            tripped = False
             with self._lock:
                 self._watchdog()
                 sim.step()
                 if publish:
-                    self._read_state()
+                    tripped = self._read_state()
                 else:
                     self._sim_time = sim.time
             pacer.step_done()
+            if publish and tripped:
+                self._on_reflex()
             if self._clock_pub is not None and not catching_up:
                 self._publish_clock()
             if publish:
-                countdown = self._publish_every
+                countdown = max(countdown, -1.0) + self._publish_every  # no burst after a backlog
                 self._publish_wrench()
                 if not state.armed(time.monotonic()):
                     self._publish_state()
@@ -208,7 +237,8 @@ class MujocoDriverNode:
                 self._sim.set_velocity_targets(self._zero)
                 rospy.loginfo_throttle(_WARN_PERIOD, "mujoco_driver: velocity commands stopped: stopping")
 
-    def _read_state(self) -> None:
+    def _read_state(self) -> bool:
+        """Copy the state into the buffers (under the lock); True if an emulated reflex tripped."""
         sim = self._sim
         data = sim.data
         np.take(data.qpos, self._qpos_adr, out=self._q)
@@ -218,6 +248,7 @@ class MujocoDriverNode:
         self._xpos[:] = self._xpos_src
         self._xquat[:] = self._xquat_src
         self._sim_time = sim.time
+        return self._emu.update(self._w) if self._emu is not None else False
 
     def _now(self) -> float:
         """The stamp clock [s]: simulated time with /clock, else the wall clock."""
@@ -241,7 +272,7 @@ class MujocoDriverNode:
     def _publish_wrench(self) -> None:
         """The wrench of the state just read: it starts the force-control chain, so it goes out first."""
         self._set_stamp()
-        w, msg = self._w, self._wrench_msg
+        w, msg = (self._w if self._emu is None else self._emu.wrench), self._wrench_msg
         msg.header.stamp = self._stamp
         f, t = msg.wrench.force, msg.wrench.torque
         f.x, f.y, f.z, t.x, t.y, t.z = w.tolist()
@@ -256,6 +287,8 @@ class MujocoDriverNode:
         # Lists serialise fastest in genpy (numpy scalars go through a slower path).
         joint.position, joint.velocity, joint.effort = self._q.tolist(), self._qd.tolist(), self._tau.tolist()
         self._joint_pub.publish(joint)
+        if self._tf_pub is not None:
+            self._publish_emulated_state()
         self._pose_countdown -= 1
         if self._pose_countdown > 0:
             return
@@ -318,11 +351,23 @@ class MujocoDriverNode:
             self._last_warning[what] = now
             rospy.logwarn(f"mujoco_driver: {what} ignored: {exc}")
 
-    def _on_trajectory(self, msg: JointTrajectory) -> None:
+    def _refused(self, controller: str | None) -> bool:
+        """Under the lock: an emulated driver ignores commands to a controller that is not running, and all
+        of them after a reflex (warned, throttled)."""
+        if controller is None or self._emu is None:
+            return False
+        reason = self._emu.refusal(controller)
+        if reason:
+            self._reject(f"{controller} command", CommandError(reason))
+        return bool(reason)
+
+    def _on_trajectory(self, msg: JointTrajectory, controller: str | None = None) -> None:
         self._latency.command_received(time.monotonic(), time.time())
         raw = [(p.positions, p.velocities, p.time_from_start.to_sec()) for p in msg.points]
         stamp = msg.header.stamp.to_sec()
         with self._lock:
+            if self._refused(controller):
+                return
             sim = self._sim
             try:
                 points = trajectory_points(msg.joint_names, raw, sim.joint_indices, sim.position_targets)
@@ -344,9 +389,11 @@ class MujocoDriverNode:
                 return
             self._velocity_active = False
 
-    def _on_velocity(self, msg: Float64MultiArray) -> None:
+    def _on_velocity(self, msg: Float64MultiArray, controller: str | None = None) -> None:
         self._latency.command_received(time.monotonic(), time.time())
         with self._lock:
+            if self._refused(controller):
+                return
             sim = self._sim
             try:
                 sim.set_velocity_targets(velocity_vector(msg.data, sim.joint_names))
@@ -381,10 +428,102 @@ class MujocoDriverNode:
                    f"({self._base_frame}) for {req.duration:g} s")
         return PushEEFResponse(success=True, message=message)
 
+    # ------------------------------------------------------------- emulation
+    def _setup_emulation(self, profile: DriverProfile, publisher: Any) -> None:
+        """The real driver's extra topics and services (see the README's *Driver emulation*)."""
+        from controller_manager_msgs.srv import ListControllers, SwitchController
+
+        self._tf_pub = publisher("/tf", TFMessage)
+        self._tf_msg = TFMessage(transforms=[TransformStamped() for _ in profile.tf])
+        for t, spec in zip(self._tf_msg.transforms, profile.tf, strict=True):
+            t.header.frame_id, t.child_frame_id = spec.parent, spec.child
+        if profile.speed_scaling_topic:
+            self._scaling_pub = publisher(profile.speed_scaling_topic, Float64)
+            self._scaling_msg = Float64(1.0)
+        cm = profile.controller_manager
+        self._services += [
+            rospy.Service(f"{cm}/list_controllers", ListControllers, self._on_list_controllers),
+            rospy.Service(f"{cm}/switch_controller", SwitchController, self._on_switch_controller),
+        ]
+        if profile.wrench.zero_service:
+            self._services.append(rospy.Service(profile.wrench.zero_service, Trigger, self._on_zero))
+        if profile.reflex is not None:
+            import actionlib
+            from driver_emulation_msgs.msg import ErrorRecoveryAction
+
+            self._mode_pub = rospy.Publisher("~robot_mode", String, queue_size=1, latch=True)
+            self._mode_pub.publish(String("move"))
+            self._recovery = actionlib.SimpleActionServer(profile.reflex.recovery_action, ErrorRecoveryAction,
+                                                          self._on_recovery, auto_start=False)
+            self._recovery.start()
+        rospy.loginfo("mujoco_driver: speaking as %s (%s): %.0f Hz, wrench %s in %s (%s), running %s",
+                      profile.driver, dict(profile.options), profile.publish_rate, profile.wrench.topic,
+                      profile.wrench.frame, profile.wrench.model, self._emu.controllers.running())
+
+    def _publish_emulated_state(self) -> None:
+        """tf and speed scaling with the joint state they belong to (same stamp)."""
+        for t, (pos, quat) in zip(self._tf_msg.transforms, self._emu.transforms, strict=True):
+            t.header.stamp = self._state_stamp
+            tr, rot = t.transform.translation, t.transform.rotation
+            tr.x, tr.y, tr.z = pos.tolist()
+            rot.x, rot.y, rot.z, rot.w = quat.tolist()
+        if self._tf_msg.transforms:
+            self._tf_pub.publish(self._tf_msg)
+        if self._scaling_pub is not None:
+            self._scaling_pub.publish(self._scaling_msg)
+
+    def _on_reflex(self) -> None:
+        rospy.logerr("mujoco_driver: %s: the arm stopped; commands are ignored until %s is called",
+                     self._emu.reflex.reason, self._emu.profile.reflex.recovery_action)
+        self._mode_pub.publish(String("reflex"))
+
+    def _on_recovery(self, _goal: Any) -> None:
+        with self._lock:
+            recovered = self._emu.recover()
+        if recovered:
+            rospy.loginfo("mujoco_driver: error recovery: the arm takes commands again")
+        self._mode_pub.publish(String("move"))
+        self._recovery.set_succeeded()
+
+    def _on_list_controllers(self, _req: Any) -> Any:
+        from controller_manager_msgs.msg import ControllerState, HardwareInterfaceResources
+        from controller_manager_msgs.srv import ListControllersResponse
+
+        with self._lock:
+            listing = self._emu.controllers.listing()
+        states = []
+        for spec, state, joints in listing:
+            claimed = ([HardwareInterfaceResources(spec.hardware_interface, joints)]
+                       if spec.hardware_interface else [])
+            states.append(ControllerState(name=spec.name, state=state, type=spec.type,
+                                          claimed_resources=claimed))
+        return ListControllersResponse(controller=states)
+
+    def _on_switch_controller(self, req: Any) -> Any:
+        from controller_manager_msgs.srv import SwitchControllerResponse
+
+        with self._lock:
+            result = self._emu.switch(list(req.start_controllers), list(req.stop_controllers), req.strictness)
+            running = self._emu.controllers.running()
+        if result.ok:
+            rospy.loginfo("mujoco_driver: switched controllers: started %s, stopped %s; running %s%s",
+                          result.started, result.stopped, running,
+                          f" ({result.message})" if result.message else "")
+        else:
+            rospy.logerr("mujoco_driver: switch_controller refused: %s", result.message)
+        return SwitchControllerResponse(ok=result.ok)
+
+    def _on_zero(self, _req: Any) -> TriggerResponse:
+        with self._lock:
+            self._emu.zero()
+        return TriggerResponse(success=True, message="the force/torque sensor reads zero now")
+
     def _on_reset(self, _req: Any) -> TriggerResponse:
         with self._lock:
             self._clock_offset += self._sim.time
             self._sim.reset()
+            if self._emu is not None and self._emu.recover():  # back at the start: no reflex either
+                self._mode_pub.publish(String("move"))
             self._velocity_active = False
             self._read_state()
         return TriggerResponse(success=True, message="back at the start pose, holding position")
@@ -413,12 +552,22 @@ def main(argv: list[str] | None = None) -> int:
         use_sim_time = bool(rospy.get_param("/use_sim_time", False))
         settings = DriverSettings.from_params(params, use_sim_time=use_sim_time)
         for key in DriverSettings.unknown_keys(params):
-            rospy.logwarn("mujoco_driver: ~%s is not a driver parameter, ignored", key)
-        if not rospy.has_param("robot_description"):
+            if key != "robot_description":
+                rospy.logwarn("mujoco_driver: ~%s is not a driver parameter, ignored", key)
+        # ~robot_description (the simulated robot itself, as an emulated driver has it) wins over the shared
+        # robot_description, which the user's own launch file may load, as on a real cell.
+        key = "~robot_description" if rospy.has_param("~robot_description") else "robot_description"
+        if not rospy.has_param(key):
             raise ParamError(f"{rospy.resolve_name('robot_description')} is not set (the URDF)")
-        urdf = rospy.get_param("robot_description")
-        node = MujocoDriverNode(settings, urdf, load_scene(settings))
-    except (ParamError, ConfigError, SceneError) as exc:
+        urdf = rospy.get_param(key)
+        profile = None
+        if settings.profile:
+            profile = load_profile(settings.profile, settings.profile_options)
+            # The real driver's names win over the driver's own topic parameters.
+            settings = dataclasses.replace(settings, joint_states_topic=profile.joint_states_topic,
+                                           wrench_topic=profile.wrench.topic, ft_frame=profile.wrench.frame)
+        node = MujocoDriverNode(settings, urdf, load_scene(settings), profile)
+    except (ParamError, ConfigError, SceneError, ProfileError) as exc:
         rospy.logfatal("mujoco_driver: %s", exc)
         rospy.signal_shutdown("bad configuration")
         return 1

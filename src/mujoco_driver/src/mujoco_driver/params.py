@@ -48,6 +48,10 @@ class DriverSettings:
         joint_states_topic, wrench_topic, trajectory_command_topic, velocity_command_topic: Topic names.
         ft_frame: header.frame_id of the wrench ("" = the scene's ``links.ft_sensor``).
         base_frame: header.frame_id of eef_pose and the frame of pushes ("" = the URDF root link).
+        profile: Driver interface profile to emulate (a name in config/profiles or a YAML path; "" = none):
+            it sets the state topics, the wrench frame and rate, and adds the real driver's controllers and
+            services (see :mod:`mujoco_driver.profiles`).
+        profile_options: The profile's options (a mapping; None = its defaults).
     """
 
     scene_config: str = ""
@@ -71,6 +75,8 @@ class DriverSettings:
     velocity_command_topic: str = "joint_group_velocity_controller/command"
     ft_frame: str = ""
     base_frame: str = ""
+    profile: str = ""
+    profile_options: Any = None
 
     @classmethod
     def from_params(cls, params: Mapping[str, Any], use_sim_time: bool = False) -> DriverSettings:
@@ -89,7 +95,7 @@ class DriverSettings:
                 continue
             value = params[f.name]
             default = getattr(cls, f.name)
-            if f.name in ("scene", "start_pose"):
+            if f.name in ("scene", "start_pose", "profile_options"):
                 values[f.name] = value
             elif isinstance(default, bool):
                 if not isinstance(value, bool):
@@ -146,6 +152,9 @@ class DriverSettings:
         for key in topics:
             if not getattr(self, key):
                 raise ParamError(f"~{key}: must not be empty")
+        if self.profile_options is not None and not isinstance(self.profile_options, Mapping):
+            raise ParamError(f"~profile_options: expected a mapping (e.g. {{series: e_series}}), got "
+                             f"{self.profile_options!r}")
         if self.start_pose is not None and not isinstance(self.start_pose, Mapping | list | tuple):
             raise ParamError(f"~start_pose: expected a list (URDF joint order) or a mapping, got "
                              f"{self.start_pose!r}")

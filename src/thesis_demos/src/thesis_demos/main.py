@@ -17,6 +17,7 @@ def _args(argv: Sequence[str]) -> argparse.Namespace:
     parser.add_argument("--robot", default="robot", help="robot name for the report title")
     parser.add_argument("--only", nargs="*", help="run only these demos (follower_z compliant_move_z ...)")
     parser.add_argument("--sensor-frame", default="ft_sensor")
+    parser.add_argument("--wrench-topic", default="/wrench", help="the wrist wrench (a real driver's topic)")
     parser.add_argument("--base-frame", default="", help="default: contact_control's ~fixed_frame")
     parser.add_argument("--timeout", type=float, default=60.0, help="seconds to wait for the stack")
     return parser.parse_args(argv)
@@ -37,7 +38,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     rospy.init_node("thesis_demos", anonymous=True, disable_signals=True)
     os.makedirs(args.output, exist_ok=True)
     started = time.monotonic()
-    runner = DemoRunner(Names(base_frame=args.base_frame), timeout=args.timeout)
+    runner = DemoRunner(Names(base_frame=args.base_frame, wrench=args.wrench_topic), timeout=args.timeout)
     results = []
     for scenario in scenarios:
         recording = runner.run(scenario, args.sensor_frame)

@@ -1,0 +1,287 @@
+"""Driver interface profiles: how the simulated robot speaks so that it looks like a given real driver.
+
+Pure (no ROS). A profile is a YAML file (``config/profiles/<name>.yaml``, or any path) naming the real
+driver's topics, frames, rates, wrench convention, controllers and reflex; the node
+(``~profile``, ``~profile_options``) applies it. Options are the user's knobs a real driver has as launch
+arguments (a UR's controller generation, franka_ros's ``publish_rate`` and ``arm_id``):
+
+* ``options``: the defaults; users may set only these keys;
+* an option named like a top-level key sets that key (``publish_rate``);
+* ``variants: {option: {value: {key: value, ...}}}``: an option's value selects overrides
+  (``series: e_series`` -> ``publish_rate: 500``);
+* every string may use ``{option}`` placeholders (``"{arm_id}_K"``).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import yaml
+
+from mujoco_driver.controllers import ControllerError, ControllerSpec
+
+__all__ = ["DriverProfile", "FrameLink", "ProfileError", "ReflexSpec", "WrenchSpec", "load_profile",
+           "profile_path"]
+
+PROFILE_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+                           "config", "profiles")
+_MODELS = ("sensor", "payload_compensated", "external_estimate")
+
+
+class ProfileError(ValueError):
+    """A profile cannot be found or is invalid; the message names the file and the key."""
+
+
+@dataclass(frozen=True)
+class WrenchSpec:
+    """How the wrench goes out.
+
+    Attributes:
+        topic: geometry_msgs/WrenchStamped topic.
+        frame: Its header.frame_id (a tf frame the profile's ``tf`` or the description provides).
+        frame_link: URDF link with the frame's origin and axes (the wrench is transformed into it).
+        model: ``sensor`` (raw wrist sensor: tool weight included), ``payload_compensated`` (the tool's
+            weight removed, as a controller that knows its payload) or ``external_estimate`` (a model-based
+            estimate: weight removed, plus a configuration-dependent offset and noise).
+        sign: +1: the wrench the environment exerts on the tool; -1: its opposite (the wrench the robot
+            exerts on the environment).
+        offset_force, offset_torque: Amplitude of the estimate's offset [N, Nm] (external_estimate).
+        offset_scale: Joint-space frequency of the offset [1/rad]: how fast it changes with the configuration.
+        noise_force, noise_torque: Standard deviation of the estimate's noise [N, Nm].
+        seed: Random seed of the offset's shape and of the noise.
+        zero_service: std_srvs/Trigger service that zeroes the wrench ("" = none).
+    """
+
+    topic: str
+    frame: str
+    frame_link: str
+    model: str = "sensor"
+    sign: float = 1.0
+    offset_force: float = 0.0
+    offset_torque: float = 0.0
+    offset_scale: float = 0.5
+    noise_force: float = 0.0
+    noise_torque: float = 0.0
+    seed: int = 0
+    zero_service: str = ""
+
+
+@dataclass(frozen=True)
+class FrameLink:
+    """A tf transform the driver publishes: ``child`` in ``parent``, which is where URDF link
+    ``child_link`` is relative to URDF link ``parent_link`` (the same link twice: identity)."""
+
+    parent: str
+    child: str
+    parent_link: str
+    child_link: str
+
+
+@dataclass(frozen=True)
+class ReflexSpec:
+    """A collision reflex: the arm stops when a component of the published wrench's magnitude exceeds its
+    threshold, and takes no motion until the recovery action is called.
+
+    Attributes:
+        force_thresholds: [fx, fy, fz, tx, ty, tz] [N, Nm].
+        recovery_action: Name of the driver_emulation_msgs/ErrorRecovery action.
+    """
+
+    force_thresholds: tuple[float, ...]
+    recovery_action: str
+
+
+@dataclass(frozen=True)
+class DriverProfile:
+    """A driver's interface, resolved from its YAML and the user's options.
+
+    Attributes:
+        driver: The real driver's name (for logs).
+        publish_rate: Rate of joint_states, the wrench, tf and speed scaling [Hz].
+        joint_states_topic: sensor_msgs/JointState topic.
+        wrench: See :class:`WrenchSpec`.
+        tf: Transforms published on /tf with the state.
+        controller_manager: Namespace of the controller manager services.
+        controllers: The loaded controllers (command topic: ``<name>/command``).
+        speed_scaling_topic: std_msgs/Float64 topic of the speed scaling factor ("" = none).
+        reflex: See :class:`ReflexSpec` (None = none).
+        options: The resolved options.
+    """
+
+    driver: str
+    publish_rate: float
+    joint_states_topic: str
+    wrench: WrenchSpec
+    tf: tuple[FrameLink, ...] = ()
+    controller_manager: str = "controller_manager"
+    controllers: tuple[ControllerSpec, ...] = ()
+    speed_scaling_topic: str = ""
+    reflex: ReflexSpec | None = None
+    options: Mapping[str, Any] = field(default_factory=dict)
+
+    def publish_steps(self, dt: float) -> float:
+        """Simulation steps per publication (fractional: the node keeps the average rate exact)."""
+        return max(1.0, 1.0 / (self.publish_rate * dt))
+
+    def links(self) -> set[str]:
+        """Every URDF link the profile needs (checked against the description by the node)."""
+        names = {self.wrench.frame_link}
+        for t in self.tf:
+            names.update((t.parent_link, t.child_link))
+        return names
+
+
+def profile_path(name_or_path: str) -> str:
+    """The YAML file of a profile name (``config/profiles/<name>.yaml``) or a path.
+
+    Raises:
+        ProfileError: If there is no such file (the message lists the profiles there are).
+    """
+    if os.sep in name_or_path or name_or_path.endswith((".yaml", ".yml")):
+        path = name_or_path
+    else:
+        path = os.path.join(PROFILE_DIR, f"{name_or_path}.yaml")
+    if not os.path.isfile(path):
+        known = sorted(f[:-5] for f in os.listdir(PROFILE_DIR) if f.endswith(".yaml")) if os.path.isdir(
+            PROFILE_DIR) else []
+        raise ProfileError(f"driver profile {name_or_path!r}: no file {path} (profiles: {known})")
+    return path
+
+
+def _format(value: Any, options: Mapping[str, Any], where: str) -> Any:
+    if isinstance(value, str):
+        try:
+            return value.format_map(options)
+        except (KeyError, ValueError) as exc:
+            raise ProfileError(f"{where}: placeholder in {value!r} is not an option ({exc})") from None
+    if isinstance(value, Mapping):
+        return {k: _format(v, options, f"{where}.{k}") for k, v in value.items()}
+    if isinstance(value, list):
+        return [_format(v, options, f"{where}[{i}]") for i, v in enumerate(value)]
+    return value
+
+
+def _number(data: Mapping[str, Any], key: str, where: str, default: float | None = None,
+            positive: bool = False) -> float:
+    value = data.get(key, default)
+    if value is None:
+        raise ProfileError(f"{where}.{key}: missing")
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise ProfileError(f"{where}.{key}: expected a finite number, got {value!r}")
+    if positive and value <= 0.0:
+        raise ProfileError(f"{where}.{key}: must be > 0, got {value}")
+    if value < 0.0:
+        raise ProfileError(f"{where}.{key}: must be >= 0, got {value}")
+    return float(value)
+
+
+def _string(data: Mapping[str, Any], key: str, where: str, default: str | None = None) -> str:
+    value = data.get(key, default)
+    if value is None or not isinstance(value, str) or (default is None and not value):
+        raise ProfileError(f"{where}.{key}: expected a non-empty string, got {value!r}")
+    return value
+
+
+def load_profile(name_or_path: str, options: Mapping[str, Any] | None = None) -> DriverProfile:
+    """Read, resolve and validate a profile.
+
+    Args:
+        name_or_path: A profile name (``ur_robot_driver``) or a YAML path.
+        options: The user's options (keys must be among the profile's ``options``).
+
+    Raises:
+        ProfileError: Naming the file and the bad key.
+    """
+    path = profile_path(name_or_path)
+    try:
+        with open(path) as stream:
+            raw = yaml.safe_load(stream)
+    except (OSError, yaml.YAMLError) as exc:
+        raise ProfileError(f"driver profile {path}: cannot read: {exc}") from None
+    if not isinstance(raw, Mapping):
+        raise ProfileError(f"driver profile {path}: expected a mapping")
+    where = os.path.basename(path)
+    resolved = dict(raw.get("options") or {})
+    for key, value in (options or {}).items():
+        if key not in resolved:
+            raise ProfileError(f"{where}: unknown option {key!r} (options: {sorted(resolved)})")
+        resolved[key] = value
+    data = {k: v for k, v in raw.items() if k not in ("options", "variants")}
+    for option, choices in (raw.get("variants") or {}).items():
+        value = resolved.get(option)
+        if value not in choices:
+            raise ProfileError(f"{where}: option {option}={value!r} must be one of {sorted(choices)}")
+        data.update(choices[value])
+    for key, value in resolved.items():
+        if key in data:
+            data[key] = value
+    data = _format(data, resolved, where)
+
+    known = {"driver", "publish_rate", "joint_states_topic", "wrench", "tf", "controller_manager",
+             "controllers", "speed_scaling_topic", "reflex"}
+    unknown = set(data) - known
+    if unknown:
+        raise ProfileError(f"{where}: unknown keys {sorted(unknown)} (known: {sorted(known)})")
+    w = data.get("wrench")
+    if not isinstance(w, Mapping):
+        raise ProfileError(f"{where}.wrench: expected a mapping")
+    wrench_keys = set(WrenchSpec.__dataclass_fields__)
+    if set(w) - wrench_keys:
+        raise ProfileError(f"{where}.wrench: unknown keys {sorted(set(w) - wrench_keys)}")
+    model = w.get("model", "sensor")
+    if model not in _MODELS:
+        raise ProfileError(f"{where}.wrench.model: one of {_MODELS}, got {model!r}")
+    sign = w.get("sign", 1)
+    if sign not in (1, -1):
+        raise ProfileError(f"{where}.wrench.sign: 1 or -1, got {sign!r}")
+    wrench = WrenchSpec(
+        topic=_string(w, "topic", f"{where}.wrench"),
+        frame=_string(w, "frame", f"{where}.wrench"),
+        frame_link=_string(w, "frame_link", f"{where}.wrench"),
+        model=model,
+        sign=float(sign),
+        offset_force=_number(w, "offset_force", f"{where}.wrench", 0.0),
+        offset_torque=_number(w, "offset_torque", f"{where}.wrench", 0.0),
+        offset_scale=_number(w, "offset_scale", f"{where}.wrench", 0.5),
+        noise_force=_number(w, "noise_force", f"{where}.wrench", 0.0),
+        noise_torque=_number(w, "noise_torque", f"{where}.wrench", 0.0),
+        seed=int(_number(w, "seed", f"{where}.wrench", 0)),
+        zero_service=_string(w, "zero_service", f"{where}.wrench", ""),
+    )
+    tf = []
+    for i, entry in enumerate(data.get("tf") or []):
+        at = f"{where}.tf[{i}]"
+        if not isinstance(entry, Mapping):
+            raise ProfileError(f"{at}: expected a mapping")
+        keys = ("parent", "child", "parent_link", "child_link")
+        tf.append(FrameLink(*(_string(entry, k, at) for k in keys)))
+    try:
+        controllers = tuple(ControllerSpec.from_dict(c) for c in data.get("controllers") or [])
+    except ControllerError as exc:
+        raise ProfileError(f"{where}.controllers: {exc}") from None
+    reflex = None
+    if data.get("reflex") is not None:
+        r = data["reflex"]
+        thresholds = r.get("force_thresholds") if isinstance(r, Mapping) else None
+        if not (isinstance(thresholds, list) and len(thresholds) == 6
+                and all(isinstance(v, int | float) and v > 0 for v in thresholds)):
+            raise ProfileError(f"{where}.reflex.force_thresholds: expected 6 positive numbers "
+                               f"[fx fy fz tx ty tz], got {thresholds!r}")
+        reflex = ReflexSpec(tuple(float(v) for v in thresholds),
+                            _string(r, "recovery_action", f"{where}.reflex"))
+    return DriverProfile(
+        driver=_string(data, "driver", where),
+        publish_rate=_number(data, "publish_rate", where, positive=True),
+        joint_states_topic=_string(data, "joint_states_topic", where),
+        wrench=wrench,
+        tf=tuple(tf),
+        controller_manager=_string(data, "controller_manager", where, "controller_manager"),
+        controllers=controllers,
+        speed_scaling_topic=_string(data, "speed_scaling_topic", where, ""),
+        reflex=reflex,
+        options=resolved,
+    )

@@ -1,0 +1,158 @@
+"""What a real driver publishes as its wrench, computed from the simulated wrist sensor (pure, numpy only).
+
+The simulation's sensor reads the wrench the environment exerts on the tool (gravity, contacts, pushes,
+the tool's inertial force) in the sensor frame. A driver reports something else:
+
+* ``sensor``: that reading, only moved into the driver's frame;
+* ``payload_compensated``: minus the tool's weight, as a controller that knows its payload (a UR with the
+  payload set: its TCP wrench reads zero at rest in any orientation);
+* ``external_estimate``: a model-based estimate from joint torques (franka's ``K_F_ext_hat_K``): net of the
+  configured load's weight, plus an offset that varies smoothly with the joint configuration (model and
+  friction errors) and white noise.
+
+Then the profile's sign: -1 reports the wrench the robot exerts on the environment (franka's convention).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from mujoco_driver.profiles import WrenchSpec
+
+__all__ = ["RateDivider", "Reflex", "WrenchModel", "change_frame", "gravity_wrench"]
+
+GRAVITY = np.array([0.0, 0.0, -9.81])
+
+
+def gravity_wrench(mass: float, com: np.ndarray, origin: np.ndarray, rotation: np.ndarray,
+                   gravity: np.ndarray = GRAVITY) -> np.ndarray:
+    """Gravity's wrench on a body of ``mass`` with centre of mass ``com``, about ``origin``, in the frame
+    ``rotation`` (columns: its axes in the world). Positions in the world [m]; returns [N, Nm]."""
+    force = mass * gravity
+    torque = np.cross(com - origin, force)
+    return np.concatenate([rotation.T @ force, rotation.T @ torque])
+
+
+def change_frame(wrench: np.ndarray, r_from: np.ndarray, p_from: np.ndarray, r_to: np.ndarray,
+                 p_to: np.ndarray) -> np.ndarray:
+    """The same wrench expressed in another frame, torque about that frame's origin.
+
+    Args:
+        wrench: [f, t] in frame "from", torque about its origin.
+        r_from, p_from: Rotation (3x3) and origin of "from" in the world.
+        r_to, p_to: Same for "to".
+    """
+    force_w = r_from @ wrench[:3]
+    torque_w = r_from @ wrench[3:] + np.cross(p_from - p_to, force_w)
+    return np.concatenate([r_to.T @ force_w, r_to.T @ torque_w])
+
+
+class WrenchModel:
+    """The driver's wrench from the simulated sensor's (see the module docstring).
+
+    Args:
+        spec: The profile's wrench section.
+        n_joints: Number of arm joints (the offset is a function of them).
+    """
+
+    def __init__(self, spec: WrenchSpec, n_joints: int) -> None:
+        self.spec = spec
+        self._rng = np.random.default_rng(spec.seed)
+        # Offset: each component a sine of a random direction in joint space (|direction| = offset_scale
+        # rad^-1) with a random phase: smooth, bounded by the amplitude, different per configuration.
+        directions = self._rng.normal(size=(6, n_joints))
+        directions *= spec.offset_scale / np.linalg.norm(directions, axis=1, keepdims=True)
+        self._directions = directions
+        self._phases = self._rng.uniform(0.0, 2.0 * np.pi, 6)
+        self._amplitude = np.array([spec.offset_force] * 3 + [spec.offset_torque] * 3)
+        self._noise = np.array([spec.noise_force] * 3 + [spec.noise_torque] * 3)
+        self._bias = np.zeros(6)
+
+    def offset(self, q: np.ndarray) -> np.ndarray:
+        """The estimate's configuration-dependent offset at joint positions ``q`` [N, Nm]."""
+        if self.spec.model != "external_estimate":
+            return np.zeros(6)
+        return self._amplitude * np.sin(self._directions @ q + self._phases)
+
+    def __call__(self, sensor: np.ndarray, weight: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """The published wrench.
+
+        Args:
+            sensor: The simulated sensor's reading, already in the driver's frame [N, Nm].
+            weight: The tool's weight in the same frame (:func:`gravity_wrench`) [N, Nm].
+            q: Arm joint positions [rad].
+
+        Returns:
+            The wrench the driver publishes (after :meth:`zero`'s bias).
+        """
+        value = np.array(sensor, dtype=float)
+        if self.spec.model != "sensor":
+            value -= weight
+        value *= self.spec.sign
+        if self.spec.model == "external_estimate":  # errors of the published estimate, whatever its sign
+            value += self.offset(q)
+            value += self._rng.normal(0.0, 1.0, 6) * self._noise
+        return value - self._bias
+
+    def zero(self, published: np.ndarray) -> None:
+        """Zero the sensor: what is published now reads zero from now on (``zero_ftsensor``)."""
+        self._bias = self._bias + np.asarray(published, dtype=float)
+
+
+class RateDivider:
+    """Publish at ``rate`` on a simulation stepping every ``dt``: :meth:`due` once per step says whether
+    this step publishes; the average rate is exact (30 Hz on 2 ms steps: every 16 or 17 steps)."""
+
+    def __init__(self, dt: float, rate: float) -> None:
+        if not (dt > 0.0 and rate > 0.0):
+            raise ValueError(f"dt and rate must be > 0, got {dt}, {rate}")
+        self.steps = max(1.0, 1.0 / (rate * dt))
+        self._countdown = 0.0
+
+    def due(self) -> bool:
+        """Count one step; True when it publishes."""
+        self._countdown -= 1.0
+        if self._countdown > 0.0:
+            return False
+        # A backlog (the caller skipped publishing) does not turn into a burst.
+        self._countdown = max(self._countdown, -1.0) + self.steps
+        return True
+
+
+class Reflex:
+    """A collision reflex on the published wrench: trips when any component's magnitude exceeds its
+    threshold; stays tripped (the arm takes no motion) until :meth:`recover`.
+
+    Args:
+        thresholds: [fx, fy, fz, tx, ty, tz] [N, Nm].
+    """
+
+    def __init__(self, thresholds: Sequence[float]) -> None:
+        self.thresholds = np.asarray(thresholds, dtype=float)
+        if self.thresholds.shape != (6,) or not np.all(self.thresholds > 0.0):
+            raise ValueError(f"reflex thresholds: expected 6 positive numbers, got {list(thresholds)}")
+        self.reason = ""
+
+    @property
+    def tripped(self) -> bool:
+        """Whether the arm is stopped by the reflex."""
+        return bool(self.reason)
+
+    def check(self, wrench: np.ndarray) -> bool:
+        """Look at one published wrench; True exactly when this one trips the reflex."""
+        if self.reason:
+            return False
+        over = np.abs(wrench) > self.thresholds
+        if not np.any(over):
+            return False
+        axes = ("fx", "fy", "fz", "tx", "ty", "tz")
+        self.reason = "cartesian_reflex: " + ", ".join(
+            f"|{axes[i]}| {abs(wrench[i]):.1f} > {self.thresholds[i]:g}" for i in np.flatnonzero(over))
+        return True
+
+    def recover(self) -> bool:
+        """Clear the reflex; True if it was tripped."""
+        was, self.reason = self.tripped, ""
+        return was

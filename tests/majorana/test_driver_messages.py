@@ -1,0 +1,36 @@
+"""controller_manager_msgs (the subset the emulated drivers serve) and driver_emulation_msgs keep the real
+packages' wire format: genmsg computes an md5sum from the definition text, so identical fields and constants
+give the md5sums that ros_control's (Noetic) and franka_msgs' generated code carry."""
+
+import pytest
+
+pytest.importorskip("controller_manager_msgs.srv", reason="needs devel/setup.bash (make test sources it)")
+
+from controller_manager_msgs import msg, srv
+from driver_emulation_msgs.msg import ErrorRecoveryActionGoal, ErrorRecoveryGoal, ErrorRecoveryResult
+
+# From ros_control's generated code (Noetic, controller_manager_msgs 0.19/0.20) and franka_msgs.
+MD5 = {
+    srv.ListControllers: "1341feb2e63fa791f855565d0da950d8",
+    srv.SwitchController: "b29a7abc673b2c54c14b54e50f8d06a5",
+    msg.ControllerState: "aeb6b261d97793ab74099a3740245272",
+    msg.HardwareInterfaceResources: "f25b55cbf1d1f76e82e5ec9e83f76258",
+    # Empty goal and result: the md5 of the empty text, whatever the package's name.
+    ErrorRecoveryGoal: "d41d8cd98f00b204e9800998ecf8427e",
+    ErrorRecoveryResult: "d41d8cd98f00b204e9800998ecf8427e",
+}
+
+
+@pytest.mark.parametrize("cls", list(MD5), ids=lambda c: c._type)
+def test_md5sum_matches_the_real_package(cls):
+    assert cls._md5sum == MD5[cls]
+
+
+def test_fields_and_constants():
+    assert srv.SwitchControllerRequest.BEST_EFFORT == 1 and srv.SwitchControllerRequest.STRICT == 2
+    assert srv.SwitchControllerRequest.__slots__ == [
+        "start_controllers", "stop_controllers", "strictness", "start_asap", "timeout"]
+    assert srv.ListControllersResponse.__slots__ == ["controller"]
+    assert msg.ControllerState.__slots__ == ["name", "state", "type", "claimed_resources"]
+    assert ErrorRecoveryActionGoal._type == "driver_emulation_msgs/ErrorRecoveryActionGoal"
+    assert ErrorRecoveryActionGoal.__slots__ == ["header", "goal_id", "goal"]
