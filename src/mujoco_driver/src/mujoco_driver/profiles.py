@@ -3,7 +3,8 @@
 Pure (no ROS). A profile is a YAML file (``config/profiles/<name>.yaml``, or any path) naming the real
 driver's topics, frames, rates, wrench convention, controllers and reflex; the node
 (``~profile``, ``~profile_options``) applies it. Options are the user's knobs a real driver has as launch
-arguments (a UR's controller generation, franka_ros's ``publish_rate`` and ``arm_id``):
+arguments (the controller generation, the state controller's ``publish_rate`` and ``arm_id``; see the
+profiles' YAML):
 
 * ``options``: the defaults; users may set only these keys;
 * an option named like a top-level key sets that key (``publish_rate``);

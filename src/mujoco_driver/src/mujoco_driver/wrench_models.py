@@ -4,13 +4,14 @@ The simulation's sensor reads the wrench the environment exerts on the tool (gra
 the tool's inertial force) in the sensor frame. A driver reports something else:
 
 * ``sensor``: that reading, only moved into the driver's frame;
-* ``payload_compensated``: minus the tool's weight, as a controller that knows its payload (a UR with the
-  payload set: its TCP wrench reads zero at rest in any orientation);
-* ``external_estimate``: a model-based estimate from joint torques (franka's ``K_F_ext_hat_K``): net of the
-  configured load's weight, plus an offset that varies smoothly with the joint configuration (model and
-  friction errors) and white noise.
+* ``payload_compensated``: minus the tool's weight, as a controller that knows its payload (with the
+  payload set, its TCP wrench reads zero at rest in any orientation);
+* ``external_estimate``: a model-based estimate from joint torques (a torque-sensing arm's driver): net of
+  the configured load's weight, plus an offset that varies smoothly with the joint configuration (model
+  and friction errors) and white noise.
 
-Then the profile's sign: -1 reports the wrench the robot exerts on the environment (franka's convention).
+Then the profile's sign: -1 reports the wrench the robot exerts on the environment (the profile YAML says
+which driver does that).
 """
 
 from __future__ import annotations
