@@ -289,13 +289,7 @@ class ContactControl:
             self._end_move(-1, END_EXTERNAL_STOP, False, "replaced by a new request")
         self._travel_offset = [0.0] * 6
         self._reaction.clear()
-        self._laws = laws
-        self._law_types = [law.law for law in laws]
-        self._actions = [law.exceeded_action if law.law and law.force_limit > 0.0 else -1 for law in laws]
-        self._active = tuple(i for i in range(6) if laws[i].law != LAW_NONE)
-        self._diff_axes = tuple(i for i in self._active if self._diff[i] > 0.0)
-        self._needs_travel = any(law.law not in _NO_TRAVEL or law.max_travel > 0.0 for law in laws if law.law)
-        self._floor = [law.law != LAW_FORCE_TRACKING for law in laws]
+        self._adopt(laws)
         for window in self._windows:
             window.clear()
         self._v = [0.0] * 6
@@ -317,6 +311,16 @@ class ContactControl:
             self._outcomes[self._move_id] = True
         return self._move_id
 
+    def _adopt(self, laws: list[AxisLaw]) -> None:
+        """What the cycle needs to know of six laws (a new move's or a changed one's)."""
+        self._laws = laws
+        self._law_types = [law.law for law in laws]
+        self._actions = [law.exceeded_action if law.law and law.force_limit > 0.0 else -1 for law in laws]
+        self._active = tuple(i for i in range(6) if laws[i].law != LAW_NONE)
+        self._diff_axes = tuple(i for i in self._active if self._diff[i] > 0.0)
+        self._needs_travel = any(law.law not in _NO_TRAVEL or law.max_travel > 0.0 for law in laws if law.law)
+        self._floor = [law.law != LAW_FORCE_TRACKING for law in laws]
+
     def _change_laws(self, laws: list[AxisLaw], t: float | None) -> int:
         """Bumpless re-configuration of a running move: an axis that keeps its law type keeps its velocity,
         travel and force-limit arming (new parameters apply from its current state, within the rate limits);
@@ -334,13 +338,7 @@ class ContactControl:
                 self._armed[i] = self._arm_time <= 0.0
         if not all(self._armed):
             self._from_rest = t
-        self._laws = laws
-        self._law_types = [law.law for law in laws]
-        self._actions = [law.exceeded_action if law.law and law.force_limit > 0.0 else -1 for law in laws]
-        self._active = tuple(i for i in range(6) if laws[i].law != LAW_NONE)
-        self._diff_axes = tuple(i for i in self._active if self._diff[i] > 0.0)
-        self._needs_travel = any(law.law not in _NO_TRAVEL or law.max_travel > 0.0 for law in laws if law.law)
-        self._floor = [law.law != LAW_FORCE_TRACKING for law in laws]
+        self._adopt(laws)
         self._end = [END_NONE] * 6
         self._ended_axis = -1
         self._move_id += 1
