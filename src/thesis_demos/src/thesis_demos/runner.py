@@ -200,6 +200,16 @@ class DemoRunner:
         ends = {a.axis: a.end_condition for a in status.axes} if status else {}
         return bool(status and (status.move_active or status.reacting)), ends
 
+    def start_tip(self) -> tuple[float, float, float]:
+        """Returns the arm to its start pose (driver reset), waits until still, and gives the tool tip [m]."""
+        self._stop()
+        result = self._reset_sim()
+        if not result.success:
+            raise RuntimeError(f"driver reset failed: {result.message}")
+        self._settle()
+        with self._pose.lock:
+            return tuple(self._pose.v[-1])  # type: ignore[return-value]
+
     # --- one scenario ---
     def run(self, scenario: Scenario, sensor_frame: str) -> Recording:
         """Resets the scene, sets the scenario's laws, pushes, and records until done."""
