@@ -18,8 +18,9 @@ from jog_arm.kinematics import ArmModel
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 ROBOTS = ("ur5_custom", "panda_custom")
-_STACK = {"/robot_state_publisher", "/jog_arm_server", "/contact_control_node"}
-_SIM_STACK = {"/robot_state_publisher", "/control_stack", "/mujoco_driver"}  # single_process by default
+_STACK = {"/robot_state_publisher", "/jog_arm_server", "/contact_control_node", "/named_poses"}
+# single_process by default
+_SIM_STACK = {"/robot_state_publisher", "/control_stack", "/mujoco_driver", "/named_poses"}
 LAUNCH_FILES = {
     "sim.launch": _SIM_STACK,
     "hardware.launch": _STACK,
@@ -105,6 +106,12 @@ def test_sim_stack_is_wired_driver_contact_control_jog_arm_driver(robot):
     assert resolve(jog["joint_topic"], "/jog_arm_server") == resolve(driver["joint_states_topic"],
                                                                     "/mujoco_driver")
     assert jog["command_in_type"] == "speed_units"  # contact_control sends m/s
+    # Named poses go through the driver's trajectory input and read its joint states.
+    poses = private(params, "/named_poses")
+    assert resolve(poses["trajectory_topic"], "/named_poses") == resolve(driver["trajectory_command_topic"],
+                                                                        "/mujoco_driver")
+    assert resolve(poses["joint_states_topic"], "/named_poses") == resolve(driver["joint_states_topic"],
+                                                                          "/mujoco_driver")
     assert cc["velocity_command_frame"] == jog["planning_frame"]
     assert pathlib.Path(driver["scene_config"]) == ROOT / "src" / robot / "config" / "sim.yaml"
     assert params["/use_sim_time"] is False and driver["viewer"] is False
