@@ -253,3 +253,20 @@ def test_trajectory_points_reorder_and_fill_missing_joints_with_the_hold_positio
 def test_trajectory_points_refuse_malformed_messages(names, points, match):
     with pytest.raises(CommandError, match=match):
         trajectory_points(names, points, _indices, np.zeros(3))
+
+
+def test_latency_probe_survives_a_command_emptying_the_queue_mid_wrench():
+    """The subscriber thread may pop every pending wrench between the stepping loop's append and its look at
+    the oldest one (seen killing the driver on a loaded machine: IndexError in wrench_sent)."""
+    import collections
+
+    probe = LatencyProbe(horizon=0.1)
+
+    class Racing(collections.deque):
+        def append(self, t):
+            super().append(t)
+            probe.command_received(t, 0.0)  # the other thread answers in between
+
+    probe._pending = Racing()
+    probe.wrench_sent(1.0)  # must not raise
+    assert probe.take() == [0.0, 0.0]

@@ -39,8 +39,12 @@ class LatencyProbe:
         """A wrench is being published at `t` (monotonic clock [s])."""
         pending = self._pending
         pending.append(t)
-        while pending[0] < t - self.horizon:
-            pending.popleft()
+        # A command arriving in another thread may empty the deque between the test and the pop.
+        try:
+            while pending[0] < t - self.horizon:
+                pending.popleft()
+        except IndexError:
+            pass
 
     def command_received(self, t: float, wall: float) -> None:
         """A joint command arrived at `t` (same clock as `wrench_sent`), `wall` being time.time() then."""
