@@ -1,7 +1,7 @@
 """Where and how far each demonstration moves on a given arm: the robot package's `config/demos.yaml`.
 
 Pure: PyYAML and numpy only. The thesis gives the laws; the distances and directions depend on the arm
-(a UR3 reaches half as far as a UR5), so they live in the robot package, with the obstacle of the
+(a small arm reaches half as far as a large one), so they live in the robot package, with the obstacle of the
 compliant move in its `config/sim.yaml`. :func:`preflight` tells, before anything moves, which
 demonstration the arm's start pose and scene cannot do, in plain words.
 
@@ -50,7 +50,7 @@ class DemoConfigError(ValueError):
 
 @dataclass(frozen=True)
 class DemoGeometry:
-    """The arm-dependent numbers of the four demonstrations (defaults: the thesis-sized UR5/Panda ones).
+    """The arm-dependent numbers of the four demonstrations (defaults: the thesis-sized ones).
 
     Attributes:
         follower_push_force: Push up along +Z in the follower demo [N] (above the 2.5 N follower deadband).
