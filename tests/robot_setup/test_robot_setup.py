@@ -83,7 +83,9 @@ def test_checker_names_an_obstacle_the_compliant_move_misses(ur3_copy):
 
 
 def test_checker_names_demo_motions_jog_arm_would_slow(ur3_copy):
-    _edit(ur3_copy / "config" / "jog_arm.yaml", "singularity_threshold: 21.5", "singularity_threshold: 9")
+    jog = ur3_copy / "config" / "jog_arm.yaml"
+    threshold = yaml.safe_load(jog.read_text())["singularity_threshold"]
+    _edit(jog, f"singularity_threshold: {threshold:g}\n", "singularity_threshold: 9\n")
     problems = check_package(str(ur3_copy))
     assert any("jog_arm.yaml singularity_threshold 9: the demos' motions reach condition number" in p
                for p in problems), problems
@@ -114,30 +116,30 @@ def test_make_robot_writes_the_committed_package_again(package, tmp_path):
         assert (root / rel).read_text() == (SRC / package / rel).read_text(), rel
 
 
-def test_generator_gives_the_ur5_the_hand_written_packages_demos_and_a_start_pose_as_good(tmp_path):
-    """What ur5_custom does by hand, the generator does for the UR5: thesis-sized demos (0.30 m hybrid travel,
-    obstacle 7 cm below the tip, compliant move at most 0.15 m), a tool-down start pose whose demo motions
-    stay below the hand-written singularity threshold, and a package the checker accepts."""
+@pytest.mark.parametrize(
+    ("hand_written", "urdf", "tip", "removed", "base"),
+    [
+        ("ur5_custom", "ur_description/urdf/ur5_robot.urdf", "tool0", (), "base_link"),
+        ("panda_custom", "panda_description/urdf/panda.urdf", "panda_link8", ("panda_hand",), "panda_link0"),
+    ],
+    ids=["ur5", "panda"],
+)
+def test_generator_does_for_the_hand_written_arms_what_their_packages_do(
+    hand_written, urdf, tip, removed, base, tmp_path
+):
+    """What ur5_custom and panda_custom do by hand, the generator does for their arms: the same base frame,
+    the gripper below the flange removed, the same thesis-sized demos (0.30 m hybrid travel, obstacle 7 cm
+    below the tip, compliant move at most 0.15 m), a tool-down start pose whose demo motions stay below the
+    hand-written singularity threshold (8), and a package the checker accepts."""
     from robot_setup.generate import RobotSpec, plan_robot, write_package
 
-    plan = plan_robot(RobotSpec("ur5gen", "ur_description/urdf/ur5_robot.urdf", "tool0"), log=lambda _: None)
-    hand = yaml.safe_load((SRC / "ur5_custom" / "config" / "demos.yaml").read_text())
-    assert plan.geometry.as_dict() == {k: {kk: float(vv) if kk != "direction" else vv for kk, vv in v.items()}
-                                       for k, v in hand.items()}
+    plan = plan_robot(RobotSpec(f"{hand_written[:-7]}gen", urdf, tip), log=lambda _: None)
+    hand = yaml.safe_load((SRC / hand_written / "config" / "demos.yaml").read_text())
+    assert plan.geometry.as_dict() == {
+        section: {k: v if k == "direction" else float(v) for k, v in values.items()}
+        for section, values in hand.items()
+    }
     assert plan.gap == pytest.approx(0.07)
-    assert plan.start.worst_condition < 8.0  # ur5_custom's singularity_threshold
-    assert plan.base == "base_link" and plan.removed == ()
-    root = write_package(plan, str(tmp_path))
-    assert check_package(root) == []
-
-
-def test_generator_removes_what_hangs_from_the_flange_like_panda_custom():
-    """panda_custom removes the hand below panda_link8 by hand; the generator does the same by itself."""
-    from robot_setup.generate import RobotSpec, _source, _tree
-
-    _, stock = _source("panda_description/urdf/panda.urdf")
-    _, children = _tree(stock)
-    assert [c for c, _, _ in children["panda_link8"]] == ["panda_hand"]
-    hand_written = (SRC / "panda_custom" / "config" / "description.args").read_text()
-    assert "--remove-link panda_hand" in hand_written
-    assert RobotSpec("p", "panda_description/urdf/panda.urdf", "panda_link8").tool_mass == 1.0
+    assert plan.start.worst_condition < 8.0
+    assert (plan.base, plan.removed) == (base, removed)
+    assert check_package(write_package(plan, str(tmp_path))) == []

@@ -50,8 +50,9 @@ from robot_setup.collisions import CollisionChecker
 __all__ = ["GeneratorError", "Plan", "RobotSpec", "main", "plan_robot", "render", "write_package"]
 
 # Arms whose tool tip reaches this far from the base axis [m] get the thesis-sized demo motions
-# (0.30 m hybrid travel, obstacle 7 cm below the tip); shorter arms get them scaled by reach / this.
-REFERENCE_REACH = 1.0
+# (0.30 m hybrid travel, obstacle 7 cm below the tip); shorter arms get them scaled by reach / this. The
+# thesis's arms, with the 0.12 m tool, reach 0.96 (Panda) and 1.01 m (UR5) measured this way.
+REFERENCE_REACH = 0.9
 TOOL_SIZE = (0.03, 0.12)  # [m] cylinder radius, length: the hand-written packages' tool
 TOOL_COM = (0.0, 0.0, 0.05)  # [m] in the sensor frame
 # Servo gain per newton-metre of the URDF's joint effort, capped (stiff like an industrial controller).
@@ -172,6 +173,9 @@ def plan_robot(spec: RobotSpec, log=print) -> Plan:
     scale = min(1.0, reach / REFERENCE_REACH)
     gap = _round(max(0.04, 0.07 * scale), 0.005)
     geometry = DemoGeometry(
+        # The follower rises about F/b x 0.8 s (0.13 m at 5 N): less push, less rise on a small arm; above the
+        # 2.5 N follower deadband and long enough to reach F/b at contact_control's acceleration.
+        follower_push_force=_round(max(3.5, 5.0 * scale), 0.1),
         compliant_max_travel=_round(gap + 0.08, 0.01),
         hybrid_travel=_round(0.30 * scale, 0.01),
     )

@@ -137,7 +137,7 @@ wrench_noise:              # Gaussian sensor noise (0: exact)
     direction = "toward the base" if g.hybrid_direction < 0 else "away from the base"
     files["config/demos.yaml"] = f"""# The four thesis demonstrations on the {name}: directions and distances (read by thesis_demos' run_demos,
 # `make demo ROBOT={name}`); {generated}. Scaled to the arm's tool-tip reach (~{plan.reach:.2f} m; thesis-sized
-# from 1.0 m). Directions are signs along the base frame's axes. The obstacle is in sim.yaml,
+# from 0.9 m). Directions are signs along the base frame's axes. The obstacle is in sim.yaml,
 # {plan.gap * 100:.1f} cm below the tool tip. Units: N, s, m, m/s.
 
 follower:                 # Z follower, b = 30 N/(m/s)
