@@ -143,3 +143,15 @@ def test_generator_does_for_the_hand_written_arms_what_their_packages_do(
     assert plan.start.worst_condition < 8.0
     assert (plan.base, plan.removed) == (base, removed)
     assert check_package(write_package(plan, str(tmp_path))) == []
+
+
+def test_a_demo_the_arm_cannot_do_is_named_with_the_reason(ur3_copy):
+    """What `make demo` prints as [CANNOT] before launching: the hybrid travel beyond the arm's reach."""
+    from robot_setup.check import problems_by_demo
+
+    _edit(ur3_copy / "config" / "demos.yaml", "travel: 0.22", "travel: 0.6")
+    general, per_demo = problems_by_demo(check_package(str(ur3_copy)))
+    assert general == []
+    assert list(per_demo) == ["hybrid"]
+    expected = "the tool-tip motion (-0.620, +0.000, +0.000) m is not reachable from the start pose"
+    assert expected in per_demo["hybrid"][0]

@@ -45,7 +45,9 @@ from thesis_demos.geometry import (
 from robot_setup.analysis import LENGTH_SCALE, MIN_JOINT_HEIGHT, MIN_MARGIN, analyse_pose, lowest_joint
 from robot_setup.collisions import CollisionChecker
 
-__all__ = ["check_package", "main", "print_report"]
+__all__ = ["DEMOS", "check_package", "main", "print_report", "problems_by_demo"]
+
+DEMOS = ("follower_z", "compliant_move_z", "spring_x", "hybrid")
 
 # jog_arm's own defaults (src/jog_arm/config/jog_arm.yaml is loaded under the robot's file).
 _JOG_DEFAULTS = {"singularity_threshold": 7.0, "hard_stop_singularity_threshold": 12.0,
@@ -191,6 +193,23 @@ def check_package(root: str) -> list[str]:
     else:
         problems.append("config/named_poses.yaml: missing (named poses, the demos' start)")
     return problems
+
+
+def problems_by_demo(problems: Sequence[str]) -> tuple[list[str], dict[str, list[str]]]:
+    """(problems of the package as a whole, problems of one demonstration by its name).
+
+    A demonstration's problems start with its name (`hybrid: the tool-tip motion ...`); the others (frames,
+    tool, start pose) concern every demonstration.
+    """
+    general: list[str] = []
+    per_demo: dict[str, list[str]] = {}
+    for problem in problems:
+        demo = problem.split(":", 1)[0]
+        if demo in DEMOS:
+            per_demo.setdefault(demo, []).append(problem.split(":", 1)[1].strip())
+        else:
+            general.append(problem)
+    return general, per_demo
 
 
 def print_report(root: str, problems: Sequence[str]) -> None:
