@@ -8,9 +8,15 @@ from harness.waiting import Collector, wait_until
 
 @pytest.fixture(scope="module")
 def stack(ros_node):
+    # Another robot's launch on the same master leaves its poses behind (seen: the Panda's before the UR5's):
+    # they must not reach this one's named_poses.
+    ros_node.set_param("/named_poses/poses/start/other_robot_joint", 1.0)
     with run_launch("ur5_custom", "sim.launch") as launched:
-        launched.wait_for_service("/named_poses/move_to", timeout=60)
-        launched.wait_for_service("/configure_cartesian_impedance", timeout=60)
+        try:
+            launched.wait_for_service("/named_poses/move_to", timeout=60)
+            launched.wait_for_service("/configure_cartesian_impedance", timeout=60)
+        except AssertionError as exc:
+            raise AssertionError(f"{exc}\n{launched.output()[-6000:]}") from None
         yield launched
 
 

@@ -1,9 +1,9 @@
 """`named_pose_server`: moves the arm to a named pose on request, through the driver's JointTrajectory input.
 
-Thin adapter over `poses` and `profile`: reads `~poses`, `~max_velocity`, `~max_acceleration` (the robot
-package's config/named_poses.yaml) and `robot_description`, listens to `joint_states` and contact_control's
-`~status`, and serves `~move_to` (compliant_control_msgs/MoveToNamedPose). The answer comes when the arm
-has arrived (every joint within `~goal_tolerance`) or the move failed.
+Thin adapter over `poses` and `profile`: reads `~config` (the robot package's config/named_poses.yaml;
+without it `~poses`, `~max_velocity`, `~max_acceleration`) and `robot_description`, listens to
+`joint_states` and contact_control's `~status`, and serves `~move_to` (MoveToNamedPose).
+The answer comes when the arm has arrived (every joint within `~goal_tolerance`) or the move failed.
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ import time
 
 import numpy as np
 import rospy
+import yaml
 from compliant_control_msgs.msg import ContactControlStatus
 from compliant_control_msgs.srv import MoveToNamedPose, MoveToNamedPoseResponse
 from sensor_msgs.msg import JointState
@@ -29,8 +30,16 @@ class NamedPoseServer:
 
     def __init__(self) -> None:
         urdf = rospy.get_param("robot_description")
-        data = {key: rospy.get_param(f"~{key}") for key in ("poses", "max_velocity", "max_acceleration")
-                if rospy.has_param(f"~{key}")}
+        config = rospy.get_param("~config", "")
+        if config:  # the file itself: a dict loaded onto the parameter server merges with a previous robot's
+            try:
+                with open(config, encoding="utf-8") as handle:
+                    data = yaml.safe_load(handle) or {}
+            except (OSError, yaml.YAMLError) as exc:
+                raise PoseError(f"~config: cannot read {config}: {exc}") from exc
+        else:
+            data = {key: rospy.get_param(f"~{key}") for key in ("poses", "max_velocity", "max_acceleration")
+                    if rospy.has_param(f"~{key}")}
         self.poses = NamedPoses.from_dict(data, urdf_joints(urdf))
         self.tolerance = float(rospy.get_param("~goal_tolerance", 0.01))  # [rad]
         self.settle_time = float(rospy.get_param("~settle_time", 3.0))  # [s] after the planned end
