@@ -51,7 +51,7 @@ __all__ = ["GeneratorError", "Plan", "RobotSpec", "main", "plan_robot", "render"
 
 # Arms whose tool tip reaches this far from the base axis [m] get the thesis-sized demo motions
 # (0.30 m hybrid travel, obstacle 7 cm below the tip); shorter arms get them scaled by reach / this. The
-# thesis's arms, with the 0.12 m tool, reach 0.96 (Panda) and 1.01 m (UR5) measured this way.
+# thesis's two arms, with the 0.12 m tool, reach 0.96 and 1.01 m measured this way (tests/robot_setup).
 REFERENCE_REACH = 0.9
 TOOL_SIZE = (0.03, 0.12)  # [m] cylinder radius, length: the hand-written packages' tool
 TOOL_COM = (0.0, 0.0, 0.05)  # [m] in the sensor frame
