@@ -6,7 +6,7 @@ DRIVER ?=
 ENV := scripts/with_env
 PYTEST_ARGS ?=
 
-.PHONY: setup build test lint demo bench clean
+.PHONY: setup build test lint demo bench robot check-robot clean
 
 setup:
 	@scripts/bootstrap setup
@@ -23,6 +23,16 @@ lint: build
 
 demo: build
 	@$(ENV) python scripts/demo --robot $(ROBOT) $(if $(DRIVER),--driver $(DRIVER))
+
+# make robot NAME=<name> URDF=<path, or relative to example-robot-data's robots/> TIP=<flange link>
+#   [BASE=<link>] [TOOL_MASS=<kg>]: writes src/<name>_custom/ and checks it.
+robot: build
+	@$(ENV) python -m robot_setup.generate --name "$(NAME)" --urdf "$(URDF)" --tip "$(TIP)" \
+		$(if $(BASE),--base "$(BASE)") $(if $(TOOL_MASS),--tool-mass "$(TOOL_MASS)") --src src
+	@scripts/bootstrap >/dev/null
+
+check-robot: build
+	@$(ENV) python -m robot_setup.check --robot $(ROBOT)
 
 bench: build
 	@$(ENV) python scripts/bench_contact_control

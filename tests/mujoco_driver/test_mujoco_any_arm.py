@@ -321,3 +321,14 @@ def test_build_scene_logs_each_changed_link(tmp_path: pathlib.Path, caplog: pyte
     assert any(line.startswith("link link2: converted (cube.dae -> ") for line in lines), lines
     assert any(line.startswith("link link3: capsule from child joints") for line in lines), lines
     assert not any("link tool:" in line for line in lines)  # kept as given: not worth a line
+
+
+def test_kinova_base_joint_turns_on_command(kinova: tuple[str, Simulation]) -> None:
+    """Its first link touches the base (welded to the world) at their joint: that pair must not rub, or the
+    continuous base joint stays put while the others move and a Cartesian jog drifts sideways."""
+    _, sim = kinova
+    sim.reset()
+    sim.set_velocity_targets([0.1, 0.0, 0.0, 0.0, 0.0, 0.0])
+    sim.step(750)  # 1.5 s at 0.1 rad/s after the 4 rad/s^2 ramp
+    assert sim.qpos[0] - KINOVA_HOME[0] == pytest.approx(0.15, abs=0.02)
+    sim.set_velocity_targets([0.0] * 6)

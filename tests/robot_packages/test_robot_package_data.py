@@ -17,16 +17,20 @@ import yaml
 from jog_arm.kinematics import ArmModel
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-ROBOTS = ("ur5_custom", "panda_custom")
-_STACK = {"/robot_state_publisher", "/jog_arm_server", "/contact_control_node"}
-_SIM_STACK = {"/robot_state_publisher", "/control_stack", "/mujoco_driver"}  # single_process by default
+ROBOTS = ("ur5_custom", "panda_custom")  # the hand-written ones (vendor drivers, joint counts)
+# Every robot package, generated ones (make robot) included: the same launch files and wiring.
+ALL_ROBOTS = tuple(sorted(p.name for p in (ROOT / "src").iterdir() if p.name.endswith("_custom")))
+_STACK = {"/robot_state_publisher", "/jog_arm_server", "/contact_control_node", "/named_poses"}
+# single_process by default
+_SIM_STACK = {"/robot_state_publisher", "/control_stack", "/mujoco_driver", "/named_poses"}
 LAUNCH_FILES = {
     "sim.launch": _SIM_STACK,
     "hardware.launch": _STACK,
     "keyboard.launch": {*_SIM_STACK, "/key_to_twist"},
 }
 OWN_LAUNCH_FILES = sorted(
-    [p for pkg in (*ROBOTS, "mujoco_driver") for p in (ROOT / "src" / pkg / "launch").rglob("*.launch*")]
+    [p for pkg in (*ALL_ROBOTS, "mujoco_driver", "named_poses")
+     for p in (ROOT / "src" / pkg / "launch").rglob("*.launch*")]
 )
 # Frames a real driver provides through tf, not the URDF (franka_state_controller's EE frame).
 # Frames the real drivers publish on tf themselves, not in any URDF (franka_state_controller: NE, EE, K;
@@ -74,14 +78,14 @@ def test_every_launch_file_is_xml_whose_declared_args_have_doc(launch_file):
     assert not undocumented, f"args without doc=: {undocumented}"
 
 
-@pytest.mark.parametrize("robot", ROBOTS)
+@pytest.mark.parametrize("robot", ALL_ROBOTS)
 @pytest.mark.parametrize("launch_file", sorted(LAUNCH_FILES))
 def test_launch_files_resolve_to_the_expected_nodes(robot, launch_file):
     nodes = set(roslaunch("--nodes", robot, launch_file).split())
     assert nodes == LAUNCH_FILES[launch_file]
 
 
-@pytest.mark.parametrize("robot", ROBOTS)
+@pytest.mark.parametrize("robot", ALL_ROBOTS)
 def test_sim_launch_can_run_contact_control_and_jog_arm_as_two_nodes_with_the_same_parameters(robot):
     nodes = set(roslaunch("--nodes", robot, "sim.launch", "single_process:=false").split())
     assert nodes == {*_STACK, "/mujoco_driver"}
@@ -91,7 +95,7 @@ def test_sim_launch_can_run_contact_control_and_jog_arm_as_two_nodes_with_the_sa
         assert private(one, node)["publish_synchronously"] is True  # the driver has a command watchdog
 
 
-@pytest.mark.parametrize("robot", ROBOTS)
+@pytest.mark.parametrize("robot", ALL_ROBOTS)
 def test_sim_stack_is_wired_driver_contact_control_jog_arm_driver(robot):
     params = dump_params(robot, "sim.launch")
     nodes = ("/mujoco_driver", "/jog_arm_server", "/contact_control_node")
@@ -107,13 +111,19 @@ def test_sim_stack_is_wired_driver_contact_control_jog_arm_driver(robot):
     assert resolve(jog["joint_topic"], "/jog_arm_server") == resolve(driver["joint_states_topic"],
                                                                     "/mujoco_driver")
     assert jog["command_in_type"] == "speed_units"  # contact_control sends m/s
+    # Named poses go through the driver's trajectory input and read its joint states.
+    poses = private(params, "/named_poses")
+    assert resolve(poses["trajectory_topic"], "/named_poses") == resolve(driver["trajectory_command_topic"],
+                                                                        "/mujoco_driver")
+    assert resolve(poses["joint_states_topic"], "/named_poses") == resolve(driver["joint_states_topic"],
+                                                                          "/mujoco_driver")
     assert cc["velocity_command_frame"] == jog["planning_frame"]
     assert pathlib.Path(driver["scene_config"]) == ROOT / "src" / robot / "config" / "sim.yaml"
     assert params["/use_sim_time"] is False and driver["viewer"] is False
     assert driver["real_time_factor"] == 1.0
 
 
-@pytest.mark.parametrize("robot", ROBOTS)
+@pytest.mark.parametrize("robot", ALL_ROBOTS)
 def test_keyboard_twists_go_to_jog_arms_input(robot):
     params = dump_params(robot, "keyboard.launch")
     keys, jog = private(params, "/key_to_twist"), private(params, "/jog_arm_server")

@@ -308,6 +308,13 @@ def build_scene(urdf_xml: str, cfg: SceneConfig, mesh_cache: str | None = None) 
         spec.add_sensor(
             name=sensor_name, type=sensor_type, objtype=mujoco.mjtObj.mjOBJ_SITE, objname=site.name
         )
+    # A link and its parent touch at their joint by design; MuJoCo only filters such pairs when the parent
+    # moves, so a first link turning on a base welded to the world would rub it (seen freezing the Jaco2's
+    # continuous base joint). Exclude every parent-child pair explicitly.
+    for body in spec.bodies:
+        parent = body.parent
+        if body.name != "world" and parent is not None and parent.name != "world":
+            spec.add_exclude(bodyname1=parent.name, bodyname2=body.name)
     _add_environment(spec, cfg)
     try:
         model = spec.compile()

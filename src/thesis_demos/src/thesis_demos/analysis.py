@@ -122,10 +122,12 @@ def _residual_force(rec: Recording, window: float = RESIDUAL_WINDOW) -> float:
 
 
 def _compliant(scenario: Scenario, rec: Recording) -> Verdict:
-    limit = scenario.laws["z"].force_limit
+    law = scenario.laws["z"]
+    limit = law.force_limit
+    direction = 1.0 if law.velocity > 0 else -1.0  # down (-1) onto the obstacle in every robot package so far
     start = rec.pose[0]
     end = rec.pose[-1]
-    travel = float(start[2] - end[2])
+    travel = float(direction * (end[2] - start[2]))
     ended_by_force = rec.end_conditions.get("z") == 1
     peak = _max(np.abs(rec.contact_force[:, 2]))
     tail = _window(rec.pose_t, rec.pose_t[-1] - 0.8, rec.pose_t[-1])
@@ -144,7 +146,8 @@ def _compliant(scenario: Scenario, rec: Recording) -> Verdict:
         passed = passed and residual < limit  # no standing press on the obstacle
     reason = "force limit" if ended_by_force else f"end condition {rec.end_conditions.get('z')}"
     summary = (
-        f"moved {travel * 1e3:.1f} mm down, stopped by {reason}, peak contact force {peak:.2f} N "
+        f"moved {travel * 1e3:.1f} mm {'up' if direction > 0 else 'down'}, stopped by {reason}, "
+        f"peak contact force {peak:.2f} N "
         f"(bound {CONTACT_FORCE_BOUND:.0f} N), {scenario.exceeded_action.replace('_', ' ')}: "
         f"residual contact force {residual:.2f} N (limit {limit:g} N), then held within {hold * 1e3:.2f} mm"
     )

@@ -14,7 +14,13 @@ __all__ = ["main"]
 def _args(argv: Sequence[str]) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--output", default="demo_output", help="folder for plots and report.md")
-    parser.add_argument("--robot", default="robot", help="robot name for the report title")
+    parser.add_argument(
+        "--robot",
+        default="",
+        help="robot name: its package <robot>_custom gives the demos' geometry (config/demos.yaml) and the "
+        "obstacle (config/sim.yaml); empty: the thesis-sized defaults, no preflight",
+    )
+    parser.add_argument("--demos-config", default="", help="a demos.yaml instead of the robot package's")
     parser.add_argument("--only", nargs="*", help="run only these demos (follower_z compliant_move_z ...)")
     parser.add_argument("--sensor-frame", default="ft_sensor")
     parser.add_argument("--wrench-topic", default="/wrench", help="the wrist wrench (a real driver's topic)")
@@ -29,18 +35,34 @@ def main(argv: Sequence[str] | None = None) -> int:
     argv = rospy.myargv(sys.argv if argv is None else list(argv))[1:]
     args = _args(argv)
     from thesis_demos.analysis import judge
+    from thesis_demos.geometry import DemoConfigError, robot_setup
     from thesis_demos.plotting import plot
     from thesis_demos.report import markdown
     from thesis_demos.runner import DemoRunner, Names
     from thesis_demos.scenarios import by_name
 
-    scenarios = by_name(args.only)
+    try:
+        setup = robot_setup(args.robot, args.demos_config)
+        scenarios = by_name(args.only, setup.geometry)
+    except (DemoConfigError, KeyError) as exc:
+        print(f"run_demos: {exc}", file=sys.stderr, flush=True)
+        return 2
+    print(f"demos' geometry: {setup.source}", flush=True)
     rospy.init_node("thesis_demos", anonymous=True, disable_signals=True)
     os.makedirs(args.output, exist_ok=True)
     started = time.monotonic()
     runner = DemoRunner(Names(base_frame=args.base_frame, wrench=args.wrench_topic), timeout=args.timeout)
     results = []
+    cannot: dict[str, str] = {}
+    if setup.checks_scene:
+        # Plain words before anything moves: what this arm's start pose and scene do not allow.
+        cannot = setup.preflight(runner.start_tip())
+        for name, reason in cannot.items():
+            if any(s.name == name for s in scenarios):
+                print(f"[CANNOT] {name}: this arm cannot do it as configured: {reason}", flush=True)
     for scenario in scenarios:
+        if scenario.name in cannot:
+            continue
         recording = runner.run(scenario, args.sensor_frame)
         verdict = judge(scenario, recording)
         png = f"{scenario.name}.png"
@@ -50,6 +72,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     runner.close()
     report = os.path.join(args.output, "report.md")
     with open(report, "w") as out:
-        out.write(markdown(args.robot, results, time.monotonic() - started))
+        out.write(markdown(args.robot or "robot", results, time.monotonic() - started))
     print(f"report: {report}", flush=True)
-    return 0 if all(v.passed for _, v, _ in results) else 1
+    refused = any(s.name in cannot for s in scenarios)
+    return 0 if all(v.passed for _, v, _ in results) and not refused else 1

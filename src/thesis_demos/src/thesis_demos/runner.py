@@ -18,7 +18,13 @@ import rospy
 import tf2_ros
 from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
 from compliant_control_msgs.msg import ContactControlStatus
-from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsRequest, PushEEF, PushEEFRequest
+from compliant_control_msgs.srv import (
+    ConfigureLaws,
+    ConfigureLawsRequest,
+    MoveToNamedPose,
+    PushEEF,
+    PushEEFRequest,
+)
 from geometry_msgs.msg import PoseStamped, WrenchStamped
 from std_srvs.srv import Trigger
 
@@ -38,6 +44,7 @@ class Names:
     configure_laws: str = "/configure_laws"
     contact_control: str = "/contact_control_node"
     driver: str = "/mujoco_driver"
+    named_poses: str = "/named_poses"  # its ~move_to brings the arm to "start" (else the driver's ~reset)
     wrench: str = "/wrench"
     base_frame: str = ""  # empty: contact_control's ~fixed_frame
 
@@ -141,6 +148,13 @@ class DemoRunner:
         self._reset_safety = rospy.ServiceProxy(f"{cc}/reset", Trigger)
         self._push = rospy.ServiceProxy(f"{drv}/push", PushEEF)
         self._reset_sim = rospy.ServiceProxy(f"{drv}/reset", Trigger)
+        self._move_to: rospy.ServiceProxy | None = None
+        try:  # started by the same launch as the rest, so it is there by now or not at all
+            rospy.wait_for_service(f"{names.named_poses}/move_to", timeout=5.0)
+            self._move_to = rospy.ServiceProxy(f"{names.named_poses}/move_to", MoveToNamedPose)
+        except rospy.ROSException:
+            rospy.logwarn("thesis_demos: no %s/move_to: the driver's ~reset brings the arm to its start pose",
+                          names.named_poses)
         self._base_frame = names.base_frame or rospy.get_param(f"{cc}/fixed_frame", "base_link")
         self._tf = tf2_ros.Buffer()
         self._tf_listener = tf2_ros.TransformListener(self._tf)
@@ -224,14 +238,30 @@ class DemoRunner:
         ends = {a.axis: a.end_condition for a in status.axes} if status else {}
         return bool(status and (status.move_active or status.reacting)), ends
 
+    def start_tip(self) -> tuple[float, float, float]:
+        """Returns the arm to its start pose, waits until still, and gives the tool tip [m]."""
+        self._to_start()
+        with self._pose.lock:
+            return tuple(self._pose.v[-1])  # type: ignore[return-value]
+
+    def _to_start(self) -> None:
+        """Named pose `start` (a joint-space move, as on a real arm), else the driver's reset; then still."""
+        self._stop()
+        if self._move_to is not None:
+            self._settle()  # the stop's last zero commands are through before the trajectory goes out
+            result = self._move_to(name="start", speed_scale=1.0)
+            if not result.success:
+                raise RuntimeError(f"named pose 'start' failed: {result.message}")
+        else:
+            result = self._reset_sim()
+            if not result.success:
+                raise RuntimeError(f"driver reset failed: {result.message}")
+        self._settle()
+
     # --- one scenario ---
     def run(self, scenario: Scenario, sensor_frame: str) -> Recording:
-        """Resets the scene, sets the scenario's laws, pushes, and records until done."""
-        self._stop()
-        result = self._reset_sim()
-        if not result.success:
-            raise RuntimeError(f"driver reset failed: {result.message}")
-        self._settle()
+        """Brings the arm to its start pose, sets the scenario's laws, pushes, and records until done."""
+        self._to_start()
         self._reset_safety()
         tare = self._tare()
         if not tare.success:

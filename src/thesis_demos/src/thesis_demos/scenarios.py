@@ -7,7 +7,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-__all__ = ["SCENARIOS", "AxisLaw", "FollowUp", "Push", "Scenario", "by_name"]
+from thesis_demos.geometry import DemoGeometry
+
+__all__ = ["SCENARIOS", "AxisLaw", "FollowUp", "Push", "Scenario", "build_scenarios", "by_name"]
 
 AXES = ("x", "y", "z", "rx", "ry", "rz")
 # cartesian_impedance_msgs/ControlLaw
@@ -83,65 +85,76 @@ class Scenario:
 
 # Thesis section 6.4, with the numbers it gives. Where it is silent: pushes of 5 N (follower) and
 # 15 N (spring), V_desired -0.01 m/s (down, onto the obstacle: a usual approach speed for contact,
-# and the contact force grows with it) and -0.05 m/s (X, toward the robot
-# base, where both robots have 0.30 m of clear travel). The compliant move backs off from the obstacle once
-# it stops (exceeded_action move_away): a position-controlled arm that stopped on contact otherwise keeps
-# pressing on it with what it overshot (up to 9 N on a simulated arm).
-SCENARIOS: tuple[Scenario, ...] = (
-    Scenario(
-        name="follower_z",
-        title="Follower law on Z (b = 30)",
-        laws={"z": AxisLaw(FOLLOWER, damping=30.0)},
-        pushes=(Push(1.0, 0.8, (0.0, 0.0, 5.0)), Push(3.5, 0.5, (4.0, 4.0, 0.0))),
-        duration=5.5,
-        controlled=("z",),
-    ),
-    Scenario(
-        name="compliant_move_z",
-        title="Compliant move on Z toward an obstacle (max force 0.5 N, max torque 0.5 Nm), then move away",
-        laws={
-            "z": AxisLaw(
-                COMPLIANT_MOVE,
-                damping=30.0,
-                velocity=-0.01,
-                force_limit=0.5,
-                torque_limit=0.5,
-                max_travel=0.15,
-            )
-        },
-        duration=11.0,
-        end_when_move_ends=True,
-        controlled=("z",),
-        exceeded_action="move_away",
-    ),
-    Scenario(
-        name="spring_x",
-        title="Spring law on X (b = 30, k = 100)",
-        laws={"x": AxisLaw(SPRING, damping=30.0, stiffness=100.0)},
-        pushes=(Push(1.0, 3.0, (15.0, 0.0, 0.0)),),
-        duration=7.0,
-        controlled=("x",),
-    ),
-    Scenario(
-        name="hybrid",
-        title="Hybrid: compliant move on X (max path deviation 0.30 m) with spring on Z (b = 30, k = 100)",
-        laws={
-            "x": AxisLaw(
-                COMPLIANT_MOVE,
-                damping=30.0,
-                velocity=-0.05,
-                force_limit=0.5,
-                torque_limit=0.5,
-                max_travel=0.30,
+# and the contact force grows with it) and -0.05 m/s along X. Directions and distances depend on the arm and
+# come from its package (config/demos.yaml, see thesis_demos.geometry); the defaults are the thesis-sized
+# ones (0.30 m toward the base). The compliant move backs off from the obstacle once it stops
+# (exceeded_action move_away): a position-controlled arm that stopped on contact otherwise keeps pressing on
+# it with what it overshot (up to 9 N on a simulated arm).
+def build_scenarios(geometry: DemoGeometry | None = None) -> tuple[Scenario, ...]:
+    """The four demonstrations with an arm's directions and distances (the thesis-sized ones when None)."""
+    g = geometry or DemoGeometry()
+    f, t = g.follower_push_force, g.follower_push_duration
+    return (
+        Scenario(
+            name="follower_z",
+            title="Follower law on Z (b = 30)",
+            laws={"z": AxisLaw(FOLLOWER, damping=30.0)},
+            pushes=(Push(1.0, t, (0.0, 0.0, f)), Push(2.7 + t, 0.5, (4.0, 4.0, 0.0))),
+            duration=4.7 + t,
+            controlled=("z",),
+        ),
+        Scenario(
+            name="compliant_move_z",
+            title=(
+                "Compliant move on Z toward an obstacle (max force 0.5 N, max torque 0.5 Nm), then move away"
             ),
-            "z": AxisLaw(SPRING, damping=30.0, stiffness=100.0),
-        },
-        pushes=(Push(1.5, 2.0, (0.0, 0.0, 15.0)),),
-        duration=9.0,
-        end_when_move_ends=True,
-        controlled=("x", "z"),
-    ),
-)
+            laws={
+                "z": AxisLaw(
+                    COMPLIANT_MOVE,
+                    damping=30.0,
+                    velocity=g.compliant_direction * g.compliant_speed,
+                    force_limit=0.5,
+                    torque_limit=0.5,
+                    max_travel=g.compliant_max_travel,
+                )
+            },
+            duration=max(11.0, 1.5 * g.compliant_max_travel / g.compliant_speed),
+            end_when_move_ends=True,
+            controlled=("z",),
+            exceeded_action="move_away",
+        ),
+        Scenario(
+            name="spring_x",
+            title="Spring law on X (b = 30, k = 100)",
+            laws={"x": AxisLaw(SPRING, damping=30.0, stiffness=100.0)},
+            pushes=(Push(1.0, 3.0, (g.spring_direction * g.spring_push_force, 0.0, 0.0)),),
+            duration=7.0,
+            controlled=("x",),
+        ),
+        Scenario(
+            name="hybrid",
+            title=(
+                f"Hybrid: compliant move on X (max path deviation {g.hybrid_travel:.2f} m) with spring on Z "
+                "(b = 30, k = 100)"
+            ),
+            laws={
+                "x": AxisLaw(
+                    COMPLIANT_MOVE,
+                    damping=30.0,
+                    velocity=g.hybrid_direction * g.hybrid_speed,
+                    force_limit=0.5,
+                    torque_limit=0.5,
+                    max_travel=g.hybrid_travel,
+                ),
+                "z": AxisLaw(SPRING, damping=30.0, stiffness=100.0),
+            },
+            pushes=(Push(1.5, 2.0, (0.0, 0.0, 15.0)),),
+            duration=max(9.0, 3.0 + 1.5 * g.hybrid_travel / g.hybrid_speed),
+            end_when_move_ends=True,
+            controlled=("x", "z"),
+        ),
+        surface_following(),
+    )
 
 
 # Surface following (the fifth demonstration, not in the thesis): Z presses on the obstacle block's top with a
@@ -167,9 +180,11 @@ _PRESS = AxisLaw(
     target_force=SURFACE_TARGET_FORCE,
 )
 
-SCENARIOS = (
-    *SCENARIOS,
-    Scenario(
+
+
+def surface_following() -> Scenario:
+    """The fifth demonstration (not in the thesis), the same on every arm: it presses on the obstacle."""
+    return Scenario(
         name="surface_following",
         title=f"Surface following: Z tracks {SURFACE_TARGET_FORCE:g} N on the block's top while X moves "
         f"{SURFACE_TRAVEL * 100:g} cm",
@@ -188,19 +203,22 @@ SCENARIOS = (
             target=SURFACE_TARGET_FORCE,
             tolerance=0.5,
         ),
-    ),
-)
+    )
 
 
-def by_name(names: list[str] | None) -> list[Scenario]:
-    """The scenarios named (all when None or empty).
+SCENARIOS: tuple[Scenario, ...] = build_scenarios()
+
+
+def by_name(names: list[str] | None, geometry: DemoGeometry | None = None) -> list[Scenario]:
+    """The scenarios named (all when None or empty), with an arm's geometry (thesis-sized when None).
 
     Raises:
         KeyError: an unknown name.
     """
+    scenarios = SCENARIOS if geometry is None else build_scenarios(geometry)
     if not names:
-        return list(SCENARIOS)
-    known = {s.name: s for s in SCENARIOS}
+        return list(scenarios)
+    known = {s.name: s for s in scenarios}
     missing = [n for n in names if n not in known]
     if missing:
         raise KeyError(f"unknown demo(s) {missing}; known: {sorted(known)}")

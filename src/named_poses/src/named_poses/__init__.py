@@ -1,0 +1,1 @@
+"""Named joint configurations and joint-space moves to them (pure: `poses`, `profile`; ROS: `node`)."""

@@ -1,0 +1,345 @@
+"""Reach analysis of an arm with its tool: start pose search, tool-tip paths, condition numbers, margins.
+
+Pure: Pinocchio through jog_arm's `ArmModel` (one angle per joint, continuous joints included), numpy.
+No ROS master. Deterministic: the same description gives the same numbers (fixed grids and seeds).
+
+Conventions (those of the robot packages and the demos):
+  * the base frame is the URDF's root; the table top is its z = 0 plane; the demos work in front of the
+    robot, along +X;
+  * "tool pointing down" = the sensor/tool frame's z axis along -Z of the base, its x axis horizontal;
+  * the condition number is jog_arm's: singular values of the tip Jacobian (LOCAL_WORLD_ALIGNED) with its
+    linear rows divided by `singularity_length_scale` (0.4 m), largest over smallest.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+from jog_arm.kinematics import ArmModel
+
+__all__ = [
+    "DOWN",
+    "PathReport",
+    "PoseReport",
+    "StartPoseError",
+    "analyse_pose",
+    "condition_number",
+    "estimate_reach",
+    "find_start_pose",
+    "lowest_joint",
+    "margins",
+    "solve_ik",
+    "tip_path",
+]
+
+# Tool pointing down: sensor x = +X, y = -Y, z = -Z of the base frame (the hand-written start poses).
+DOWN = np.diag([1.0, -1.0, -1.0])
+LENGTH_SCALE = 0.4  # [m] jog_arm's singularity_length_scale default
+IK_TOLERANCE = 1e-6  # [m, rad] a pose counts as reached below this error
+PATH_STEPS = 20
+# A start pose is refused closer than this to a joint limit anywhere on the demos' motions [rad].
+MIN_MARGIN = 0.15
+# Every joint origin but the first stays this high over the table (z = 0) at the start pose [m]: no elbow
+# reaching under the table top.
+MIN_JOINT_HEIGHT = 0.05
+
+
+class StartPoseError(RuntimeError):
+    """No start pose satisfies the demands (the message says which were tried and why they failed)."""
+
+
+def condition_number(arm: ArmModel, q: np.ndarray, length_scale: float = LENGTH_SCALE) -> float:
+    """jog_arm's condition number of the tip Jacobian at `q` (linear rows divided by `length_scale`)."""
+    jac = arm.jacobian(np.asarray(q, dtype=float)).copy()
+    jac[:3] /= length_scale
+    sv = np.linalg.svd(jac, compute_uv=False)
+    return float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
+
+
+def margins(arm: ArmModel, q: np.ndarray) -> np.ndarray:
+    """Distance of each joint to its nearer position limit [rad]; inf for unbounded (continuous) joints."""
+    q = np.asarray(q, dtype=float)
+    return np.minimum(q - arm.lower, arm.upper - q)
+
+
+def lowest_joint(arm: ArmModel, q: np.ndarray) -> float:
+    """Height [m] of the lowest joint origin after the first (which sits on the base), base frame."""
+    arm.frame_pose(np.asarray(q, dtype=float), arm.tip_frame)  # forward kinematics into arm.data
+    return float(min(arm.data.oMi[j].translation[2] for j in range(2, arm.model.njoints)))
+
+
+def _pose_error(arm: ArmModel, q: np.ndarray, goal: pin.SE3) -> np.ndarray:
+    """(position error, rotation error) in base axes, 6-vector, goal minus current."""
+    now = arm.frame_pose(q, arm.tip_frame)
+    rot = pin.log3(goal.rotation @ now.rotation.T)
+    return np.concatenate([goal.translation - now.translation, rot])
+
+
+def solve_ik(
+    arm: ArmModel, goal: pin.SE3, seed: np.ndarray, iterations: int = 200, limit_margin: float = 0.0
+) -> np.ndarray | None:
+    """Damped least-squares IK of the tool tip to `goal`, joints kept `limit_margin` inside their limits.
+
+    Returns:
+        The joint angles (one per joint, model order), or None if it did not converge.
+    """
+    q = np.array(seed, dtype=float)
+    lo, hi = arm.lower + limit_margin, arm.upper - limit_margin
+    for _ in range(iterations):
+        err = _pose_error(arm, q, goal)
+        if float(np.linalg.norm(err)) < IK_TOLERANCE:
+            return q
+        jac = arm.jacobian(q)
+        damping = 1e-6 + 1e-3 * min(1.0, float(np.linalg.norm(err)))
+        step = jac.T @ np.linalg.solve(jac @ jac.T + damping * np.eye(6), err)
+        biggest = float(np.max(np.abs(step)))
+        if biggest > 0.5:  # far from the goal: no wild jumps across branches
+            step *= 0.5 / biggest
+        q = np.clip(q + step, lo, hi)
+    return q if float(np.linalg.norm(_pose_error(arm, q, goal))) < IK_TOLERANCE else None
+
+
+@dataclass(frozen=True)
+class PathReport:
+    """A straight tool-tip motion from the start pose, orientation held.
+
+    Attributes:
+        offset: The displacement [m], base axes.
+        reachable: Every step was reached (no joint limit or singularity in the way).
+        worst_condition: Largest condition number on the way.
+        min_margin: Smallest distance of a joint to its limits on the way [rad].
+        contact: Bodies that touch on the way (self-collision or the table), empty if none or unchecked.
+    """
+
+    offset: tuple[float, float, float]
+    reachable: bool
+    worst_condition: float
+    min_margin: float
+    contact: str = ""
+
+
+def tip_path(
+    arm: ArmModel, q0: np.ndarray, offset: Sequence[float], steps: int = PATH_STEPS
+) -> tuple[list[np.ndarray], bool]:
+    """Joint configurations moving the tip in a straight line by `offset` [m], orientation held.
+
+    Returns:
+        (the configurations reached, one per step; True if every step was reached).
+    """
+    start = arm.frame_pose(np.asarray(q0, dtype=float), arm.tip_frame).copy()
+    q = np.array(q0, dtype=float)
+    path = []
+    for k in range(1, steps + 1):
+        goal = pin.SE3(start.rotation, start.translation + np.asarray(offset, dtype=float) * k / steps)
+        solved = solve_ik(arm, goal, q, iterations=50)
+        if solved is None or float(np.max(np.abs(solved - q))) > 0.5:  # a jump = a branch switch
+            return path, False
+        q = solved
+        path.append(q.copy())
+    return path, True
+
+
+@dataclass(frozen=True)
+class PoseReport:
+    """A start pose and what the demos' motions do from it.
+
+    Attributes:
+        q: Joint angles [rad], model order.
+        joint_names: Model order.
+        tip: Tool tip position [m], base frame.
+        condition: Condition number at the pose.
+        margins: Per joint distance to the limits at the pose [rad] (inf: continuous).
+        paths: Per demonstration, its motions.
+        contact: Bodies touching at the pose itself (empty: none or unchecked).
+    """
+
+    q: np.ndarray
+    joint_names: tuple[str, ...]
+    tip: np.ndarray
+    condition: float
+    margins: np.ndarray
+    paths: dict[str, list[PathReport]] = field(default_factory=dict)
+    contact: str = ""
+
+    @property
+    def reachable(self) -> bool:
+        return all(p.reachable for reports in self.paths.values() for p in reports)
+
+    @property
+    def collision_free(self) -> bool:
+        return not self.contact and not any(p.contact for r in self.paths.values() for p in r)
+
+    @property
+    def worst_condition(self) -> float:
+        return max([self.condition] + [p.worst_condition for r in self.paths.values() for p in r])
+
+    @property
+    def min_margin(self) -> float:
+        on_paths = [p.min_margin for r in self.paths.values() for p in r]
+        return float(min([float(np.min(self.margins)), *on_paths]))
+
+    def problems(self, hard_stop: float | None = None) -> list[str]:
+        """What is wrong with this pose for the demos, in plain words (empty: nothing)."""
+        out = [f"start pose: {self.contact} touch"] if self.contact else []
+        for demo, reports in self.paths.items():
+            for p in reports:
+                dx, dy, dz = p.offset
+                where = f"{demo}: the tool-tip motion ({dx:+.3f}, {dy:+.3f}, {dz:+.3f}) m"
+                if not p.reachable:
+                    out.append(f"{where} is not reachable from the start pose (joint limit or singularity)")
+                elif p.contact:
+                    out.append(f"{where} makes {p.contact} touch (the arm would hit itself or the table)")
+                elif hard_stop is not None and p.worst_condition >= hard_stop:
+                    out.append(
+                        f"{where} reaches condition number {p.worst_condition:.1f}, at or above jog_arm's "
+                        f"hard stop {hard_stop:g}"
+                    )
+                elif p.min_margin < MIN_MARGIN:
+                    out.append(
+                        f"{where} comes {p.min_margin:.2f} rad from a joint limit (at least "
+                        f"{MIN_MARGIN} rad wanted)"
+                    )
+        return out
+
+
+def analyse_pose(
+    arm: ArmModel, q0: np.ndarray, motions: Mapping[str, Sequence[Sequence[float]]],
+    length_scale: float = LENGTH_SCALE, contacts: Callable[[np.ndarray], list[str]] | None = None,
+) -> PoseReport:
+    """Condition numbers, joint-limit margins and (with `contacts`) collisions at `q0` and along each
+    demonstration's motions (every fifth step and the last)."""
+    q0 = np.asarray(q0, dtype=float)
+    paths: dict[str, list[PathReport]] = {}
+    for demo, offsets in motions.items():
+        paths[demo] = []
+        for offset in offsets:
+            path, ok = tip_path(arm, q0, offset)
+            conds = [condition_number(arm, q, length_scale) for q in path] or [math.inf]
+            mins = [float(np.min(margins(arm, q))) for q in path] or [-math.inf]
+            touching: list[str] = []
+            if contacts is not None:
+                for q in path[4::5] + path[-1:]:
+                    touching += [c for c in contacts(q) if c not in touching]
+            paths[demo].append(
+                PathReport(tuple(float(v) for v in offset), ok, max(conds), min(mins), ", ".join(touching))
+            )
+    return PoseReport(
+        q=q0,
+        joint_names=arm.joint_names,
+        tip=arm.frame_pose(q0, arm.tip_frame).translation.copy(),
+        condition=condition_number(arm, q0, length_scale),
+        margins=margins(arm, q0),
+        paths=paths,
+        contact=", ".join(contacts(q0)) if contacts is not None else "",
+    )
+
+
+def _seeds(arm: ArmModel, count: int = 6) -> list[np.ndarray]:
+    """Deterministic IK seeds: mid-range, then fixed pseudo-random configurations within the limits."""
+    lo = np.where(np.isfinite(arm.lower), arm.lower, -math.pi)
+    hi = np.where(np.isfinite(arm.upper), arm.upper, math.pi)
+    rng = np.random.default_rng(0)
+    seeds = [(lo + hi) / 2.0]
+    seeds += [lo + (hi - lo) * (0.15 + 0.7 * rng.random(arm.nv)) for _ in range(count - 1)]
+    return seeds
+
+
+def _off_centre(arm: ArmModel, q: np.ndarray) -> float:
+    """Mean distance of the joints from the middle of their ranges, as a fraction of the half range."""
+    lo = np.where(np.isfinite(arm.lower), arm.lower, -math.pi)
+    hi = np.where(np.isfinite(arm.upper), arm.upper, math.pi)
+    return float(np.mean(np.abs(q - (lo + hi) / 2.0) / ((hi - lo) / 2.0)))
+
+
+def estimate_reach(arm: ArmModel, samples: int = 2000) -> float:
+    """How far the tool tip gets from the first joint's axis [m]: the largest horizontal distance of the
+    tip from the base's z axis over fixed pseudo-random configurations (a lower bound of the true reach)."""
+    rng = np.random.default_rng(1)
+    lo = np.where(np.isfinite(arm.lower), arm.lower, -math.pi)
+    hi = np.where(np.isfinite(arm.upper), arm.upper, math.pi)
+    best = 0.0
+    for _ in range(samples):
+        q = lo + (hi - lo) * rng.random(arm.nv)
+        p = arm.frame_pose(q, arm.tip_frame).translation
+        best = max(best, float(math.hypot(p[0], p[1])))
+    return best
+
+
+def _rot_z(yaw: float) -> np.ndarray:
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def find_start_pose(
+    arm: ArmModel,
+    reach: float,
+    motions_for: Callable[[np.ndarray], Mapping[str, Sequence[Sequence[float]]]],
+    length_scale: float = LENGTH_SCALE,
+    max_condition: float = 25.0,
+    heights: Sequence[float] | None = None,
+    contacts: Callable[[np.ndarray], list[str]] | None = None,
+) -> PoseReport:
+    """The best start pose: tool pointing down in front of the robot, the demos' motions reachable.
+
+    Candidates are tool-tip positions on a fixed grid (x from 0.35 to 0.7 of `reach` along +X, y within
+    +-0.15 of it, heights as given, default 0.2 to 0.45 of it) and tool yaws of 0, 90, 180, -90 degrees; every
+    IK solution from fixed seeds is analysed along `motions_for(tip)` (the demos' displacements, which may
+    depend on the height). Kept: all motions reachable, never closer than MIN_MARGIN to a joint limit, worst
+    condition number below `max_condition`. Chosen: the lowest worst condition number, ties to larger margins.
+
+    Raises:
+        StartPoseError: No candidate passes; the message gives the closest one's problems.
+    """
+    heights = list(heights) if heights is not None else [reach * f for f in (0.2, 0.28, 0.36, 0.45)]
+    xs = [reach * f for f in (0.45, 0.55, 0.4, 0.62, 0.35, 0.7)]
+    ys = [0.0, 0.08 * reach, -0.08 * reach, 0.15 * reach, -0.15 * reach]
+    yaws = [0.0, math.pi / 2, math.pi, -math.pi / 2]
+    seeds = _seeds(arm)
+    best: tuple[float, PoseReport] | None = None
+    closest: tuple[float, PoseReport] | None = None
+    for z in heights:
+        for x in xs:
+            for y in ys:
+                for yaw in yaws:
+                    goal = pin.SE3(_rot_z(yaw) @ DOWN, np.array([x, y, z]))
+                    found: list[np.ndarray] = []
+                    for seed in seeds:
+                        q = solve_ik(arm, goal, seed, limit_margin=MIN_MARGIN)
+                        if q is None or any(np.allclose(q, f, atol=1e-3) for f in found):
+                            continue
+                        found.append(q)
+                    for q in found:
+                        if condition_number(arm, q, length_scale) >= max_condition:
+                            continue
+                        if lowest_joint(arm, q) < MIN_JOINT_HEIGHT:
+                            continue
+                        if contacts is not None and contacts(q):
+                            continue
+                        motions = motions_for(np.array([x, y, z]))
+                        report = analyse_pose(arm, q, motions, length_scale, contacts)
+                        worst = report.worst_condition
+                        # Lowest condition number first; then joints near the middle of their ranges (a
+                        # familiar posture rather than one wound round a +-2 pi joint) and wider margins.
+                        score = worst + 2.0 * _off_centre(arm, q) - 0.5 * min(report.min_margin, 1.0)
+                        usable = report.reachable and report.collision_free
+                        usable = usable and report.min_margin >= MIN_MARGIN
+                        if usable and worst < max_condition:
+                            if best is None or score < best[0] - 1e-9:
+                                best = (score, report)
+                        elif closest is None or score < closest[0]:
+                            closest = (score, report)
+        if best is not None and z >= heights[min(1, len(heights) - 1)]:
+            break  # a good pose at a moderate height: higher ones only shorten the follower's room
+    if best is None:
+        none = "no tool-down IK solution in front of the robot"
+        detail = "; ".join(closest[1].problems()) if closest else none
+        raise StartPoseError(
+            "no start pose with the tool pointing down lets the demos' motions run (reach estimate "
+            f"{reach:.2f} m, "
+            f"condition number below {max_condition:g}, {MIN_MARGIN} rad from every joint limit): {detail}"
+        )
+    return best[1]

@@ -1,0 +1,248 @@
+"""`make check-robot ROBOT=<name>`: is a robot package consistent, and can its arm do the demonstrations?
+
+Pure (no ROS master): reads the package's files, builds the description like make_description, and names
+every problem found:
+  * frames the YAML files name (scene links, jog_arm's and contact_control's frames) missing from the
+    description;
+  * the tool's mass and centre of mass differing between description.args and contact_control.yaml;
+  * the start pose outside or near (< 0.15 rad) its joint limits, a joint origin under the table, the arm
+    touching itself or the table (MuJoCo's collision check on the simulated scene);
+  * the demonstrations' motions (config/demos.yaml) unreachable from the start pose, slowed by jog_arm's
+    singularity threshold or stopped by its hard stop;
+  * the scene's obstacle not where the compliant move can meet it (thesis_demos' preflight);
+  * named poses whose `start` is not the scene's start pose.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import shlex
+import sys
+from collections.abc import Sequence
+
+import numpy as np
+import yaml
+from jog_arm.kinematics import ArmModel, KinematicsError
+from mujoco_driver.description import (
+    DescriptionError,
+    ToolSpec,
+    _parser,
+    build_description,
+    find_example_robot_data,
+    read_source,
+)
+from thesis_demos.geometry import (
+    DemoConfigError,
+    demo_motions,
+    load_geometry,
+    load_obstacle,
+    preflight,
+    tool_radius,
+)
+
+from robot_setup.analysis import LENGTH_SCALE, MIN_JOINT_HEIGHT, MIN_MARGIN, analyse_pose, lowest_joint
+from robot_setup.collisions import CollisionChecker
+
+__all__ = ["DEMOS", "check_package", "main", "print_report", "problems_by_demo"]
+
+DEMOS = ("follower_z", "compliant_move_z", "spring_x", "hybrid")
+
+# jog_arm's own defaults (src/jog_arm/config/jog_arm.yaml is loaded under the robot's file).
+_JOG_DEFAULTS = {"singularity_threshold": 7.0, "hard_stop_singularity_threshold": 12.0,
+                 "singularity_length_scale": LENGTH_SCALE}
+
+
+def _yaml(path: str) -> dict:
+    with open(path, encoding="utf-8") as handle:
+        return yaml.safe_load(handle) or {}
+
+
+def _description(args_path: str) -> tuple[str, argparse.Namespace]:
+    with open(args_path, encoding="utf-8") as handle:
+        words = [w for line in handle for w in shlex.split(line, comments=True)]
+    args = _parser().parse_args(words)
+    erd = find_example_robot_data() if args.source.startswith("example-robot-data:") else None
+    tool = ToolSpec(
+        parent=args.tool_parent, ft_name=args.ft_name, ft_xyz=tuple(args.ft_xyz), ft_rpy=tuple(args.ft_rpy),
+        name=args.tool_name, mass=args.tool_mass, com=tuple(args.tool_com) if args.tool_com else None,
+        inertia=tuple(args.tool_inertia) if args.tool_inertia else None, shape=args.tool_shape,
+        size=tuple(args.tool_size), tip_name=args.tip_name,
+    ) if args.tool_parent else None
+    urdf = build_description(read_source(args.source, erd), tool, args.remove_link, erd, args.robot_name)
+    return urdf, args
+
+
+def check_package(root: str) -> list[str]:
+    """Every problem of the robot package at `root`, in plain words (empty: none).
+
+    The analysis lines (start pose, motions) are appended to `check_package.last_analysis` for printing.
+    """
+    problems: list[str] = []
+    info: list[str] = []
+    check_package.last_analysis = info  # type: ignore[attr-defined]
+    cfg = os.path.join(root, "config")
+    try:
+        urdf, args = _description(os.path.join(cfg, "description.args"))
+    except (OSError, DescriptionError, SystemExit) as exc:
+        return [f"config/description.args: cannot build the description: {exc}"]
+    try:
+        scene = _yaml(os.path.join(cfg, "sim.yaml"))
+        jog = {**_JOG_DEFAULTS, **_yaml(os.path.join(cfg, "jog_arm.yaml"))}
+        cc = _yaml(os.path.join(cfg, "contact_control.yaml"))
+    except (OSError, yaml.YAMLError) as exc:
+        return [f"cannot read the package's YAML: {exc}"]
+    import pinocchio as pin
+
+    full = pin.buildModelFromXML(urdf)
+    named = {
+        "sim.yaml links.ft_sensor": scene.get("links", {}).get("ft_sensor", "ft_sensor"),
+        "sim.yaml links.tool": scene.get("links", {}).get("tool", "tool"),
+        "sim.yaml links.eef": scene.get("links", {}).get("eef", "tool_tip"),
+        **{f"jog_arm.yaml {k}": jog.get(k) for k in ("ee_frame_name", "planning_frame", "cmd_frame")},
+        **{f"contact_control.yaml {k}": cc.get(k) for k in
+           ("fixed_frame", "velocity_command_frame", "ft_sensor_frame", "control_frame", "eef_frame")},
+    }
+    for where, frame in named.items():
+        if not frame:
+            problems.append(f"{where}: not set")
+        elif not full.existFrame(frame):
+            problems.append(f"{where}: frame {frame!r} is not in the description (description.args)")
+    # Tool: what the description carries must be what contact_control subtracts.
+    cc_mass, cc_com = cc.get("tool_mass", 0.0), cc.get("tool_com", [0.0, 0.0, 0.0])
+    if args.tool_parent:
+        if not math.isclose(float(cc_mass), args.tool_mass, abs_tol=1e-9):
+            problems.append(
+                f"tool mass: description.args --tool-mass {args.tool_mass} kg, contact_control.yaml "
+                f"tool_mass {cc_mass} kg: gravity compensation would leave "
+                f"{abs(args.tool_mass - float(cc_mass)) * 9.81:.2f} N"
+            )
+        desc_com = list(args.tool_com) if args.tool_com else None
+        if desc_com is None:
+            spec_len = args.tool_size[1] if args.tool_shape == "cylinder" else (
+                args.tool_size[2] if args.tool_shape == "box" else 2 * args.tool_size[0])
+            desc_com = [0.0, 0.0, spec_len / 2.0]
+        if not np.allclose(desc_com, cc_com, atol=1e-6):
+            problems.append(
+                f"tool centre of mass: description.args --tool-com {desc_com} m, contact_control.yaml "
+                "tool_com "
+                f"{list(cc_com)} m"
+            )
+    # Start pose, margins, the demos' motions.
+    tip = jog.get("ee_frame_name", "tool_tip")
+    try:
+        arm = ArmModel(urdf, tip)
+    except KinematicsError as exc:
+        return [*problems, f"jog_arm cannot model the arm: {exc}"]
+    start = scene.get("start_pose") or {}
+    missing = [j for j in arm.joint_names if j not in start]
+    if missing:
+        return [*problems, f"sim.yaml start_pose: no angle for joints {missing}"]
+    q0 = np.array([float(start[j]) for j in arm.joint_names])
+    scale = float(jog["singularity_length_scale"])
+    threshold, hard_stop = float(jog["singularity_threshold"]), float(jog["hard_stop_singularity_threshold"])
+    try:
+        geometry = load_geometry(os.path.join(cfg, "demos.yaml"))
+        obstacle = load_obstacle(os.path.join(cfg, "sim.yaml"))
+    except DemoConfigError as exc:
+        return [*problems, str(exc)]
+    tip_xyz = arm.frame_pose(q0, tip).translation
+    radius = tool_radius(os.path.join(cfg, "description.args"))
+    for demo, reason in preflight(geometry, tip_xyz, obstacle, radius).items():
+        problems.append(f"{demo}: {reason}")
+    gap = None
+    if obstacle is not None:
+        gap = float(tip_xyz[2] - obstacle.top) if geometry.compliant_direction < 0 else None
+    contacts = None
+    if np.all((q0 >= arm.lower) & (q0 <= arm.upper)):  # the scene refuses a start pose outside the limits
+        contacts = CollisionChecker(urdf, arm.joint_names, q0).contacts
+    report = analyse_pose(arm, q0, demo_motions(geometry, approach=gap), scale, contacts)
+    for name, m, lo, hi, q in zip(arm.joint_names, report.margins, arm.lower, arm.upper, q0, strict=True):
+        if m < 0:
+            problems.append(f"start pose: {name} = {q:.4f} rad is outside its limits [{lo:.4f}, {hi:.4f}]")
+        elif m < MIN_MARGIN:
+            problems.append(
+                f"start pose: {name} is {m:.3f} rad from a limit (at least {MIN_MARGIN} rad wanted)"
+            )
+    if lowest_joint(arm, q0) < MIN_JOINT_HEIGHT:
+        problems.append(f"start pose: a joint origin is {lowest_joint(arm, q0):.3f} m over the table (under "
+                        f"{MIN_JOINT_HEIGHT} m)")
+    problems += report.problems(hard_stop)
+    if report.reachable and report.worst_condition >= threshold:
+        problems.append(
+            f"jog_arm.yaml singularity_threshold {threshold:g}: the demos' motions reach condition number "
+            f"{report.worst_condition:.2f}, so jog_arm would slow them (raise it above that)"
+        )
+    finite = [m for m in report.margins if math.isfinite(m)]
+    info.append(
+        f"start pose: tool tip at ({tip_xyz[0]:.3f}, {tip_xyz[1]:.3f}, {tip_xyz[2]:.3f}) m, condition number "
+        f"{report.condition:.2f}, joint-limit margin {min(finite) if finite else math.inf:.2f} rad; "
+        "demos' motions: "
+        f"condition <= {report.worst_condition:.2f} (threshold {threshold:g}, hard stop "
+        f"{hard_stop:g}), margin >= "
+        f"{report.min_margin:.2f} rad"
+    )
+    poses_path = os.path.join(cfg, "named_poses.yaml")
+    if os.path.isfile(poses_path):
+        named_start = (_yaml(poses_path).get("poses") or {}).get("start")
+        if named_start is None:
+            problems.append("named_poses.yaml: no pose 'start' (the demos move there)")
+        elif any(abs(float(named_start.get(j, math.nan)) - float(start[j])) > 1e-9 for j in arm.joint_names):
+            problems.append("named_poses.yaml: poses.start differs from sim.yaml's start_pose")
+    else:
+        problems.append("config/named_poses.yaml: missing (named poses, the demos' start)")
+    return problems
+
+
+def problems_by_demo(problems: Sequence[str]) -> tuple[list[str], dict[str, list[str]]]:
+    """(problems of the package as a whole, problems of one demonstration by its name).
+
+    A demonstration's problems start with its name (`hybrid: the tool-tip motion ...`); the others (frames,
+    tool, start pose) concern every demonstration.
+    """
+    general: list[str] = []
+    per_demo: dict[str, list[str]] = {}
+    for problem in problems:
+        demo = problem.split(":", 1)[0]
+        if demo in DEMOS:
+            per_demo.setdefault(demo, []).append(problem.split(":", 1)[1].strip())
+        else:
+            general.append(problem)
+    return general, per_demo
+
+
+def print_report(root: str, problems: Sequence[str]) -> None:
+    """The checker's verdict on stdout."""
+    for line in getattr(check_package, "last_analysis", []):
+        print(f"[check] {line}")
+    if problems:
+        print(f"[check] {os.path.basename(root)}: {len(problems)} problem(s):")
+        for p in problems:
+            print(f"[check]   - {p}")
+    else:
+        print(f"[check] {os.path.basename(root)}: OK (frames, tool, start pose, demos' reach)")
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """`make check-robot ROBOT=<name>`: exit 1 and name the problems, 0 when none."""
+    parser = argparse.ArgumentParser(prog="make check-robot", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--robot", required=True, help="robot name: checks the package <robot>_custom")
+    parser.add_argument("--path", default="", help="the package's directory (default: found by name)")
+    args = parser.parse_args(argv)
+    root = args.path
+    if not root:
+        from thesis_demos.geometry import find_robot_package
+
+        try:
+            root = find_robot_package(args.robot)
+        except DemoConfigError as exc:
+            print(f"make check-robot: {exc}", file=sys.stderr)
+            return 2
+    problems = check_package(root)
+    print_report(root, problems)
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

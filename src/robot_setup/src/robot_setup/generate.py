@@ -1,0 +1,312 @@
+"""`make robot NAME=<name> URDF=<urdf> TIP=<flange link>`: write the robot package `src/<name>_custom/`.
+
+The package has the shape of the hand-written ones (description arguments, scene, contact_control and
+jog_arm settings, named poses, the demos' geometry, launch files, README): only YAML and launch files. The
+numbers that depend on the arm are measured here (Pinocchio, `robot_setup.analysis`):
+
+  * the reach, and from it the demonstrations' distances (thesis-sized for arms reaching REFERENCE_REACH
+    or more, scaled down below) and the obstacle (under the tool tip, its top `gap` below it);
+  * the start pose: tool pointing down over the table, joints away from their limits, the lowest
+    condition number along the demos' motions;
+  * jog_arm's singularity thresholds from the condition numbers measured along those motions;
+  * servo gains from the URDF's joint efforts.
+
+Reproducible: fixed grids and seeds, rounded numbers, no dates; the same command writes the same files.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import xml.etree.ElementTree as ET
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from jog_arm.kinematics import ArmModel
+from mujoco_driver.description import (
+    ERD_PACKAGE,
+    DescriptionError,
+    ToolSpec,
+    build_description,
+    find_example_robot_data,
+    read_source,
+)
+from thesis_demos.geometry import DemoGeometry, demo_motions
+
+from robot_setup.analysis import (
+    LENGTH_SCALE,
+    PoseReport,
+    StartPoseError,
+    analyse_pose,
+    estimate_reach,
+    find_start_pose,
+    lowest_joint,
+)
+from robot_setup.collisions import CollisionChecker
+
+__all__ = ["GeneratorError", "Plan", "RobotSpec", "main", "plan_robot", "render", "write_package"]
+
+# Arms whose tool tip reaches this far from the base axis [m] get the thesis-sized demo motions
+# (0.30 m hybrid travel, obstacle 7 cm below the tip); shorter arms get them scaled by reach / this. The
+# thesis's two arms, with the 0.12 m tool, reach 0.96 and 1.01 m measured this way (tests/robot_setup).
+REFERENCE_REACH = 0.9
+TOOL_SIZE = (0.03, 0.12)  # [m] cylinder radius, length: the hand-written packages' tool
+TOOL_COM = (0.0, 0.0, 0.05)  # [m] in the sensor frame
+# Servo gain per newton-metre of the URDF's joint effort, capped (stiff like an industrial controller).
+KP_PER_NM, KP_MAX, KP_MIN = 120.0, 20000.0, 1000.0
+KV_RATIO = 0.02  # kv = kp * this [s]
+
+
+class GeneratorError(ValueError):
+    """Bad input (unknown link, missing URDF, bad name or mass), named."""
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    """What the user gives: `make robot NAME=... URDF=... TIP=... [BASE=...] [TOOL_MASS=...]`."""
+
+    name: str
+    urdf: str  # a path, or a path relative to example-robot-data's robots/
+    tip: str  # the flange link the sensor and tool go on
+    base: str = ""  # the base frame; empty: the URDF root (or its only fixed child, if the root is a 'world')
+    tool_mass: float = 1.0  # [kg]
+
+
+@dataclass(frozen=True)
+class Plan:
+    """Everything the package's files say, measured."""
+
+    spec: RobotSpec
+    source: str  # make_description's --source
+    removed: tuple[str, ...]  # subtrees below the flange (a gripper the tool replaces)
+    base: str
+    urdf_xml: str
+    joints: tuple[str, ...]
+    reach: float
+    geometry: DemoGeometry
+    gap: float
+    obstacle_size: tuple[float, float, float]
+    obstacle_position: tuple[float, float, float]
+    start: PoseReport
+    home: np.ndarray
+    threshold: float
+    hard_stop: float
+    kp: tuple[float, ...]
+    kv: tuple[float, ...]
+    armature: float
+    efforts: tuple[float, ...]
+
+
+def _source(urdf: str) -> tuple[str, str]:
+    """(make_description's --source, the URDF text)."""
+    if os.path.isabs(urdf) or os.path.isfile(urdf):
+        path = os.path.abspath(urdf)
+        if not os.path.isfile(path):
+            raise GeneratorError(f"URDF={urdf}: no such file")
+        return path, read_source(path)
+    source = f"{ERD_PACKAGE}:robots/{urdf}"
+    try:
+        return source, read_source(source, find_example_robot_data())
+    except DescriptionError as exc:
+        raise GeneratorError(
+            f"URDF={urdf}: neither a file nor a path under example-robot-data's robots/ ({exc})"
+        ) from exc
+
+
+def _tree(urdf_xml: str) -> tuple[str, dict[str, list[tuple[str, str, ET.Element]]]]:
+    """(root link, parent link -> [(child link, joint type, joint element)])."""
+    robot = ET.fromstring(urdf_xml)
+    children: dict[str, list[tuple[str, str, ET.Element]]] = {}
+    child_links = set()
+    for joint in robot.findall("joint"):
+        parent, child = joint.find("parent").get("link"), joint.find("child").get("link")
+        children.setdefault(parent, []).append((child, joint.get("type"), joint))
+        child_links.add(child)
+    roots = [link.get("name") for link in robot.findall("link") if link.get("name") not in child_links]
+    if len(roots) != 1:
+        raise GeneratorError(f"the URDF must have one root link, found {roots}")
+    return roots[0], children
+
+
+def _default_base(root: str, children: dict, urdf_xml: str) -> str:
+    """The URDF root, or its only child when the root is a massless 'world' fixed to it (the UR's)."""
+    robot = ET.fromstring(urdf_xml)
+    link = next(lnk for lnk in robot.findall("link") if lnk.get("name") == root)
+    kids = children.get(root, [])
+    if link.find("inertial") is None and len(kids) == 1 and kids[0][1] == "fixed":
+        return kids[0][0]
+    return root
+
+
+def _round(value: float, step: float) -> float:
+    return round(round(value / step) * step, 6)
+
+
+def plan_robot(spec: RobotSpec, log=print) -> Plan:
+    """Measure the arm and decide every number of its package (see the module docstring).
+
+    Raises:
+        GeneratorError: Bad input, or no usable start pose (why, in words).
+    """
+    name = spec.name
+    if not name or not name.replace("_", "").isalnum() or not name[0].isalpha() or name != name.lower():
+        raise GeneratorError(f"NAME={spec.name!r}: use lower-case letters, digits and _ (a ROS package name)")
+    if not spec.tool_mass > 0:
+        raise GeneratorError(f"TOOL_MASS={spec.tool_mass}: must be positive [kg]")
+    source, stock = _source(spec.urdf)
+    root, children = _tree(stock)
+    links = {lnk.get("name") for lnk in ET.fromstring(stock).findall("link")}
+    if spec.tip not in links:
+        raise GeneratorError(f"TIP={spec.tip!r} is not a link of {spec.urdf}; links: {sorted(links)}")
+    base = spec.base or _default_base(root, children, stock)
+    if base not in links:
+        raise GeneratorError(f"BASE={base!r} is not a link of {spec.urdf}; links: {sorted(links)}")
+    removed = tuple(child for child, _, _ in children.get(spec.tip, []))
+    tool = ToolSpec(parent=spec.tip, mass=spec.tool_mass, com=TOOL_COM, size=TOOL_SIZE)
+    urdf_xml = build_description(stock, tool, removed)
+    arm = ArmModel(urdf_xml, tool.tip_name)
+    reach = estimate_reach(arm)
+    log(f"[robot] {spec.name}: {arm.nv} joints {list(arm.joint_names)}, tool-tip reach ~{reach:.2f} m")
+    scale = min(1.0, reach / REFERENCE_REACH)
+    gap = _round(max(0.04, 0.07 * scale), 0.005)
+    geometry = DemoGeometry(
+        # The follower rises about F/b x 0.8 s (0.13 m at 5 N): less push, less rise on a small arm; above the
+        # 2.5 N follower deadband and long enough to reach F/b at contact_control's acceleration.
+        follower_push_force=_round(max(3.5, 5.0 * scale), 0.1),
+        compliant_max_travel=_round(gap + 0.08, 0.01),
+        hybrid_travel=_round(0.30 * scale, 0.01),
+    )
+    log(
+        f"[robot] demos scaled by {scale:.2f}: hybrid travel {geometry.hybrid_travel:.2f} m along "
+        f"{'-' if geometry.hybrid_direction < 0 else '+'}X, obstacle {gap * 100:.1f} cm below the tip, "
+        f"compliant move at most {geometry.compliant_max_travel:.2f} m"
+    )
+    motions = demo_motions(geometry, approach=gap)
+    heights = [h for h in (reach * f for f in (0.2, 0.28, 0.36, 0.45)) if h >= gap + 0.04]
+    bounded = np.isfinite(arm.lower) & np.isfinite(arm.upper)
+    mid = (np.where(bounded, arm.lower, 0.0) + np.where(bounded, arm.upper, 0.0)) / 2.0
+    contacts = CollisionChecker(urdf_xml, arm.joint_names, mid).contacts
+    try:
+        found = find_start_pose(arm, reach, lambda tip: motions, heights=heights, contacts=contacts)
+    except StartPoseError as exc:
+        raise GeneratorError(str(exc)) from exc
+    q0 = np.round(found.q, 4)  # what the files say, analysed again as written
+    start = analyse_pose(arm, q0, motions, contacts=contacts)
+    tip = start.tip
+    worst = start.worst_condition
+    threshold = max(6.0, math.ceil(worst * 1.2 * 2.0) / 2.0)
+    hard_stop = float(max(12.0, math.ceil(threshold * 1.5)))
+    top = float(tip[2] - gap)
+    footprint = _round(max(0.10, 0.15 * scale), 0.01)
+    obstacle_size = (footprint, footprint, _round(top, 0.001))
+    obstacle_position = (_round(tip[0], 0.001), _round(tip[1], 0.001), _round(top / 2.0, 0.0005))
+    # Home: the start pose lifted 0.1 m (scaled), clear of the obstacle.
+    lift = analyse_pose(arm, q0, {"home": [(0.0, 0.0, 0.1 * scale)]})
+    from robot_setup.analysis import tip_path
+
+    path, ok = tip_path(arm, q0, (0.0, 0.0, 0.1 * scale))
+    home = np.round(path[-1], 4) if ok and lift.reachable else q0
+    efforts = []
+    robot = ET.fromstring(urdf_xml)
+    for name in arm.joint_names:
+        joint = next(j for j in robot.findall("joint") if j.get("name") == name)
+        limit = joint.find("limit")
+        efforts.append(float(limit.get("effort", 0.0)) if limit is not None else 0.0)
+    kp = tuple(_round(min(KP_MAX, max(KP_MIN, KP_PER_NM * e)), 100.0) if e > 0 else KP_MIN for e in efforts)
+    kv = tuple(_round(k * KV_RATIO, 1.0) for k in kp)
+    armature = 0.2 if max(efforts) > 100.0 else 0.1
+    plan = Plan(
+        spec=spec, source=source, removed=removed, base=base, urdf_xml=urdf_xml, joints=arm.joint_names,
+        reach=reach, geometry=geometry, gap=gap, obstacle_size=obstacle_size,
+        obstacle_position=obstacle_position, start=start, home=home, threshold=threshold, hard_stop=hard_stop,
+        kp=kp, kv=kv, armature=armature, efforts=tuple(efforts),
+    )
+    for line in analysis_lines(plan, arm):
+        log(f"[robot] {line}")
+    return plan
+
+
+def analysis_lines(plan: Plan, arm: ArmModel | None = None) -> list[str]:
+    """The start pose analysis in words (printed by the generator, written into the README)."""
+    s = plan.start
+    finite = [(n, m) for n, m in zip(plan.joints, s.margins, strict=True) if math.isfinite(m)]
+    closest = min(finite, key=lambda nm: nm[1]) if finite else ("(all continuous)", math.inf)
+    lines = [
+        f"start pose: tool pointing down, tool tip at ({s.tip[0]:.3f}, {s.tip[1]:.3f}, {s.tip[2]:.3f}) m in "
+        f"{plan.base}; condition number {s.condition:.2f} (length scale {LENGTH_SCALE} m)",
+        f"joint-limit margin at the start pose {closest[1]:.2f} rad ({closest[0]}), at least "
+        f"{s.min_margin:.2f} rad "
+        "on the demos' motions",
+    ]
+    if arm is not None:
+        lines.append(f"lowest joint origin {lowest_joint(arm, s.q):.3f} m over the table")
+    for demo, reports in s.paths.items():
+        for p in reports:
+            lines.append(
+                f"  {demo}: tip motion ({p.offset[0]:+.3f}, {p.offset[1]:+.3f}, {p.offset[2]:+.3f}) m: "
+                f"{'reachable' if p.reachable else 'NOT reachable'}, condition <= {p.worst_condition:.2f}, "
+                f"margin >= {p.min_margin:.2f} rad"
+            )
+    lines.append(
+        f"jog_arm: singularity_threshold {plan.threshold:g} (1.2 x the worst {s.worst_condition:.2f}, "
+        "so the demos "
+        f"run unscaled), hard_stop_singularity_threshold {plan.hard_stop:g}"
+    )
+    return lines
+
+
+def _yaml_joints(values: Sequence[float], joints: Sequence[str], indent: int = 2, fmt: str = "{:.4f}") -> str:
+    pad = " " * indent
+    return "\n".join(f"{pad}{j}: {fmt.format(v)}" for j, v in zip(joints, values, strict=True))
+
+
+def render(plan: Plan) -> dict[str, str]:
+    """The package's files: relative path -> text."""
+    from robot_setup import templates
+
+    return templates.render(plan, analysis_lines(plan))
+
+
+def write_package(plan: Plan, src_dir: str) -> str:
+    """Write `src_dir/<name>_custom/`; returns its path. Existing files of the same names are replaced."""
+    root = os.path.join(src_dir, f"{plan.spec.name}_custom")
+    for rel, text in render(plan).items():
+        path = os.path.join(root, rel)
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        with open(path, "w", encoding="utf-8") as handle:
+            handle.write(text)
+    return root
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """`make robot`: plan, write, then run the checker on the written package."""
+    parser = argparse.ArgumentParser(prog="make robot", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--name", required=True, help="robot name: the package is <name>_custom")
+    parser.add_argument(
+        "--urdf", required=True, help="URDF path, or a path under example-robot-data's robots/"
+    )
+    parser.add_argument("--tip", required=True, help="flange link the F/T sensor and tool go on")
+    parser.add_argument("--base", default="", help="base frame (default: the URDF root)")
+    parser.add_argument("--tool-mass", type=float, default=1.0, help="tool mass [kg] (default 1.0)")
+    parser.add_argument("--src", default=os.path.join(os.getcwd(), "src"), help="workspace src/ directory")
+    args = parser.parse_args(argv)
+    spec = RobotSpec(args.name, args.urdf, args.tip, args.base, args.tool_mass)
+    try:
+        plan = plan_robot(spec)
+    except (GeneratorError, DescriptionError) as exc:
+        print(f"make robot: error: {exc}", file=sys.stderr)
+        return 2
+    root = write_package(plan, args.src)
+    print(f"[robot] wrote {root} (run `make build`, then `make demo ROBOT={spec.name}`)")
+    from robot_setup.check import check_package, print_report
+
+    problems = check_package(root)
+    print_report(root, problems)
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,81 @@
+"""named_poses on the simulated UR5: move_to goes there within the joint limits, and refuses what it must."""
+
+import numpy as np
+import pytest
+from harness.launch import run_launch
+from harness.waiting import Collector, wait_until
+
+
+@pytest.fixture(scope="module")
+def stack(ros_node):
+    # Another robot's launch on the same master leaves its poses behind (seen: the Panda's before the UR5's):
+    # they must not reach this one's named_poses.
+    ros_node.set_param("/named_poses/poses/start/other_robot_joint", 1.0)
+    with run_launch("ur5_custom", "sim.launch") as launched:
+        try:
+            launched.wait_for_service("/named_poses/move_to", timeout=60)
+            launched.wait_for_service("/configure_cartesian_impedance", timeout=60)
+        except AssertionError as exc:
+            raise AssertionError(f"{exc}\n{launched.output()[-6000:]}") from None
+        yield launched
+
+
+def _proxy():
+    import rospy
+    from compliant_control_msgs.srv import MoveToNamedPose
+
+    return rospy.ServiceProxy("/named_poses/move_to", MoveToNamedPose)
+
+
+def test_move_to_home_arrives_within_the_joint_velocity_limit(stack):
+    import yaml
+    from rospkg import RosPack
+    from sensor_msgs.msg import JointState
+
+    config = yaml.safe_load(open(RosPack().get_path("ur5_custom") + "/config/named_poses.yaml"))
+    home = config["poses"]["home"]
+    states = Collector("/joint_states", JointState, queue_size=1000)
+    try:
+        states.wait_for(1)
+        answer = _proxy()(name="home", speed_scale=1.0)
+        assert answer.success, answer.message
+        last = states.last()
+        at = dict(zip(last.name, last.position, strict=True))
+        assert max(abs(at[j] - q) for j, q in home.items()) < 0.01
+        speeds = np.array([m.velocity for _, m in states.timed()])
+        assert np.max(np.abs(speeds)) <= config["max_velocity"] * 1.05
+        assert np.max(np.abs(speeds)) > 0.3 * config["max_velocity"], "it moved, at a useful speed"
+        back = _proxy()(name="start", speed_scale=0.5)
+        assert back.success, back.message
+    finally:
+        states.close()
+
+
+def test_unknown_pose_is_refused_with_the_known_names(stack):
+    answer = _proxy()(name="lunch", speed_scale=1.0)
+    assert not answer.success
+    assert "known: ['home', 'start']" in answer.message
+
+
+def test_refused_while_a_contact_move_runs(stack):
+    import rospy
+    from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
+    from compliant_control_msgs.msg import ContactControlStatus
+    from std_srvs.srv import Trigger
+
+    req = ConfigureForceControlRequest()
+    req.direction_control_laws.x.type = 3  # compliant move, slowly along -X
+    req.cart_impedance_params.damping.translational.x = 30.0
+    req.cart_impedance_params.max_cart_vel.set.linear.x = -0.01
+    req.cart_impedance_params.max_path_deviation.translation.x = 0.05
+    assert rospy.ServiceProxy("/configure_cartesian_impedance", ConfigureForceControl)(req).success
+    try:
+        status = "/contact_control_node/status"
+        wait_until(
+            lambda: rospy.wait_for_message(status, ContactControlStatus, 5).move_active, 10, "a contact move"
+        )
+        answer = _proxy()(name="home", speed_scale=1.0)
+        assert not answer.success
+        assert "a contact move is running" in answer.message
+    finally:
+        rospy.ServiceProxy("/contact_control_node/stop", Trigger)()

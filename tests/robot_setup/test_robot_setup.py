@@ -1,0 +1,157 @@
+"""Adding an arm: the checker names what is wrong with a robot package, the generator refuses bad input,
+finds a start pose the demos can use, and writes the same files for the same command (the committed
+generated packages are exactly what `make robot` writes)."""
+
+from __future__ import annotations
+
+import pathlib
+import re
+import shutil
+
+import pytest
+import yaml
+from robot_setup.check import check_package
+
+SRC = pathlib.Path(__file__).resolve().parents[2] / "src"
+ROBOT_PACKAGES = sorted(p.name for p in SRC.iterdir() if p.name.endswith("_custom"))
+
+
+def _generated_command(package: str) -> dict | None:
+    """The `make robot` arguments a generated package records in its README (None: hand-written)."""
+    match = re.search(r"`make robot NAME=(\S+) URDF=(\S+) TIP=(\S+)(?: BASE=(\S+))? TOOL_MASS=(\S+)`",
+                      (SRC / package / "README.md").read_text())
+    if not match:
+        return None
+    name, urdf, tip, base, mass = match.groups()
+    return {"name": name, "urdf": urdf, "tip": tip, "base": base or "", "tool_mass": float(mass)}
+
+
+GENERATED = [p for p in ROBOT_PACKAGES if _generated_command(p)]
+
+
+@pytest.mark.parametrize("package", ROBOT_PACKAGES)
+def test_every_robot_package_passes_the_checker(package):
+    assert check_package(str(SRC / package)) == []
+
+
+@pytest.fixture
+def ur3_copy(tmp_path):
+    root = tmp_path / "ur3_custom"
+    shutil.copytree(SRC / "ur3_custom", root)
+    return root
+
+
+def _edit(path: pathlib.Path, old: str, new: str) -> None:
+    text = path.read_text()
+    assert old in text
+    path.write_text(text.replace(old, new))
+
+
+def test_checker_names_a_tool_mass_that_differs_from_the_description(ur3_copy):
+    _edit(ur3_copy / "config" / "contact_control.yaml", "tool_mass: 1 ", "tool_mass: 1.5 ")
+    (problem,) = check_package(str(ur3_copy))
+    assert problem.startswith("tool mass: description.args --tool-mass 1.0 kg, contact_control.yaml")
+    assert "tool_mass 1.5 kg: gravity compensation would leave 4.91 N" in problem
+
+
+def test_checker_names_a_tool_com_that_differs(ur3_copy):
+    config = ur3_copy / "config" / "contact_control.yaml"
+    _edit(config, "tool_com: [0.0, 0.0, 0.05]", "tool_com: [0.0, 0.0, 0.08]")
+    assert any(p.startswith("tool centre of mass") for p in check_package(str(ur3_copy)))
+
+
+def test_checker_names_a_frame_missing_from_the_description(ur3_copy):
+    _edit(ur3_copy / "config" / "jog_arm.yaml", "planning_frame: base_link", "planning_frame: base_lnk")
+    assert "jog_arm.yaml planning_frame: frame 'base_lnk' is not in the description (description.args)" in (
+        check_package(str(ur3_copy))
+    )
+
+
+def test_checker_names_a_start_pose_near_a_joint_limit(ur3_copy):
+    scene = ur3_copy / "config" / "sim.yaml"
+    data = yaml.safe_load(scene.read_text())
+    _edit(scene, f"elbow_joint: {data['start_pose']['elbow_joint']:.4f}", "elbow_joint: 3.0800")
+    problems = check_package(str(ur3_copy))
+    assert any(p.startswith("start pose: elbow_joint is 0.062 rad from a limit") for p in problems), problems
+
+
+def test_checker_names_an_obstacle_the_compliant_move_misses(ur3_copy):
+    _edit(ur3_copy / "config" / "sim.yaml", "position: [0.366,", "position: [0.566,")
+    problems = check_package(str(ur3_copy))
+    assert any(p.startswith("compliant_move_z: the obstacle") and "not under the tool tip" in p
+               for p in problems), problems
+
+
+def test_checker_names_demo_motions_jog_arm_would_slow(ur3_copy):
+    jog = ur3_copy / "config" / "jog_arm.yaml"
+    threshold = yaml.safe_load(jog.read_text())["singularity_threshold"]
+    _edit(jog, f"singularity_threshold: {threshold:g}\n", "singularity_threshold: 9\n")
+    problems = check_package(str(ur3_copy))
+    assert any("jog_arm.yaml singularity_threshold 9: the demos' motions reach condition number" in p
+               for p in problems), problems
+
+
+def test_generator_refuses_an_unknown_flange_and_names_the_links():
+    from robot_setup.generate import GeneratorError, RobotSpec, plan_robot
+
+    with pytest.raises(GeneratorError, match=r"TIP='flange' is not a link of .*links: \[.*'tool0'"):
+        plan_robot(RobotSpec("ur3", "ur_description/urdf/ur3_robot.urdf", "flange"), log=lambda _: None)
+    with pytest.raises(GeneratorError, match=r"URDF=nowhere\.urdf: neither a file nor a path"):
+        plan_robot(RobotSpec("x", "nowhere.urdf", "tool0"), log=lambda _: None)
+    with pytest.raises(GeneratorError, match="NAME='UR-3'"):
+        plan_robot(RobotSpec("UR-3", "ur_description/urdf/ur3_robot.urdf", "tool0"), log=lambda _: None)
+
+
+@pytest.mark.parametrize("package", GENERATED)
+def test_make_robot_writes_the_committed_package_again(package, tmp_path):
+    """Reproducible: the same command gives the same files (the start pose search included)."""
+    from robot_setup.generate import RobotSpec, plan_robot, write_package
+
+    spec = RobotSpec(**_generated_command(package))
+    root = pathlib.Path(write_package(plan_robot(spec, log=lambda _: None), str(tmp_path)))
+    written = sorted(p.relative_to(root) for p in root.rglob("*") if p.is_file())
+    committed = sorted(p.relative_to(SRC / package) for p in (SRC / package).rglob("*") if p.is_file())
+    assert written == committed
+    for rel in written:
+        assert (root / rel).read_text() == (SRC / package / rel).read_text(), rel
+
+
+@pytest.mark.parametrize(
+    ("hand_written", "urdf", "tip", "removed", "base"),
+    [
+        ("ur5_custom", "ur_description/urdf/ur5_robot.urdf", "tool0", (), "base_link"),
+        ("panda_custom", "panda_description/urdf/panda.urdf", "panda_link8", ("panda_hand",), "panda_link0"),
+    ],
+    ids=["ur5", "panda"],
+)
+def test_generator_does_for_the_hand_written_arms_what_their_packages_do(
+    hand_written, urdf, tip, removed, base, tmp_path
+):
+    """What ur5_custom and panda_custom do by hand, the generator does for their arms: the same base frame,
+    the gripper below the flange removed, the same thesis-sized demos (0.30 m hybrid travel, obstacle 7 cm
+    below the tip, compliant move at most 0.15 m), a tool-down start pose whose demo motions stay below the
+    hand-written singularity threshold (8), and a package the checker accepts."""
+    from robot_setup.generate import RobotSpec, plan_robot, write_package
+
+    plan = plan_robot(RobotSpec(f"{hand_written[:-7]}gen", urdf, tip), log=lambda _: None)
+    hand = yaml.safe_load((SRC / hand_written / "config" / "demos.yaml").read_text())
+    assert plan.geometry.as_dict() == {
+        section: {k: v if k == "direction" else float(v) for k, v in values.items()}
+        for section, values in hand.items()
+    }
+    assert plan.gap == pytest.approx(0.07)
+    assert plan.start.worst_condition < 8.0
+    assert (plan.base, plan.removed) == (base, removed)
+    assert check_package(write_package(plan, str(tmp_path))) == []
+
+
+def test_a_demo_the_arm_cannot_do_is_named_with_the_reason(ur3_copy):
+    """What `make demo` prints as [CANNOT] before launching: the hybrid travel beyond the arm's reach."""
+    from robot_setup.check import problems_by_demo
+
+    _edit(ur3_copy / "config" / "demos.yaml", "travel: 0.22", "travel: 0.6")
+    general, per_demo = problems_by_demo(check_package(str(ur3_copy)))
+    assert general == []
+    assert list(per_demo) == ["hybrid"]
+    expected = "the tool-tip motion (-0.620, +0.000, +0.000) m is not reachable from the start pose"
+    assert expected in per_demo["hybrid"][0]

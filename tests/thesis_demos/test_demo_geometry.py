@@ -1,0 +1,106 @@
+"""The demonstrations take an arm's directions and distances from its package, and say beforehand what
+the arm cannot do."""
+
+import pathlib
+
+import pytest
+from thesis_demos.geometry import (
+    DemoConfigError,
+    DemoGeometry,
+    Obstacle,
+    load_geometry,
+    load_obstacle,
+    preflight,
+    tool_radius,
+)
+from thesis_demos.scenarios import SCENARIOS, build_scenarios, by_name
+
+SRC = pathlib.Path(__file__).resolve().parents[2] / "src"
+ROBOT_PACKAGES = sorted(p for p in SRC.iterdir() if p.name.endswith("_custom"))
+
+
+def test_defaults_are_the_thesis_sized_scenarios():
+    hybrid = by_name(["hybrid"])[0]
+    assert hybrid.laws["x"].max_travel == 0.30 and hybrid.laws["x"].velocity == -0.05
+    assert by_name(["compliant_move_z"])[0].laws["z"].velocity == -0.01
+    assert SCENARIOS == build_scenarios(DemoGeometry())
+
+
+def test_a_smaller_arm_gets_shorter_motions_in_its_directions():
+    g = DemoGeometry.from_dict({
+        "hybrid": {"travel": 0.15, "direction": 1},
+        "compliant_move": {"max_travel": 0.10},
+        "spring": {"direction": -1},
+        "follower": {"push_duration": 0.5},
+    })
+    hybrid, = by_name(["hybrid"], g)
+    assert hybrid.laws["x"].max_travel == 0.15 and hybrid.laws["x"].velocity == 0.05
+    assert by_name(["compliant_move_z"], g)[0].laws["z"].max_travel == 0.10
+    assert by_name(["spring_x"], g)[0].pushes[0].force[0] == -15.0
+    follower, = by_name(["follower_z"], g)
+    assert follower.pushes[0].duration == 0.5 and follower.pushes[1].start > follower.pushes[0].end
+
+
+@pytest.mark.parametrize(
+    ("data", "named"),
+    [
+        ({"hybrid": {"travel": -0.1}}, "hybrid.travel"),
+        ({"hybrid": {"direction": 0}}, "hybrid.direction"),
+        ({"spring": {"push": 3}}, "spring: unknown keys ['push']"),
+        ({"dance": {}}, "unknown sections ['dance']"),
+        ({"follower": {"push_force": "five"}}, "follower.push_force"),
+    ],
+)
+def test_bad_demos_yaml_names_the_key(data, named):
+    with pytest.raises(DemoConfigError, match=named.replace("[", r"\[").replace("]", r"\]")):
+        DemoGeometry.from_dict(data)
+
+
+def test_geometry_round_trips_through_yaml_mapping():
+    g = DemoGeometry(hybrid_travel=0.17, hybrid_direction=1, compliant_max_travel=0.11)
+    assert DemoGeometry.from_dict(g.as_dict()) == g
+
+
+BOX = Obstacle((0.6, 0.1, 0.065), (0.15, 0.15, 0.13))
+
+
+def test_preflight_passes_the_thesis_setup():
+    assert preflight(DemoGeometry(), (0.6, 0.1, 0.20), BOX, 0.03) == {}
+
+
+def test_preflight_names_an_obstacle_beside_the_tool():
+    problems = preflight(DemoGeometry(), (0.3, 0.1, 0.20), BOX, 0.03)
+    assert "not under the tool tip" in problems["compliant_move_z"]
+
+
+def test_preflight_names_an_obstacle_out_of_reach_of_the_move():
+    problems = preflight(DemoGeometry(compliant_max_travel=0.05), (0.6, 0.1, 0.20), BOX, 0.03)
+    assert "would end by its path deviation, not by contact" in problems["compliant_move_z"]
+
+
+def test_preflight_names_a_tool_already_touching():
+    problems = preflight(DemoGeometry(), (0.6, 0.1, 0.14), BOX, 0.03)
+    assert "needs at least" in problems["compliant_move_z"]
+
+
+def test_preflight_names_a_hybrid_path_through_the_obstacle():
+    # Starting beside the box, low, and travelling toward it.
+    problems = preflight(DemoGeometry(hybrid_direction=-1), (0.9, 0.1, 0.10), BOX, 0.03)
+    assert "run into the obstacle" in problems["hybrid"]
+
+
+def test_preflight_without_obstacle_refuses_only_the_compliant_move():
+    problems = preflight(DemoGeometry(), (0.6, 0.1, 0.20), None)
+    assert list(problems) == ["compliant_move_z"]
+
+
+@pytest.mark.parametrize("package", ROBOT_PACKAGES, ids=lambda p: p.name)
+def test_every_robot_package_has_demos_its_start_pose_and_scene_allow(package):
+    g = load_geometry(str(package / "config" / "demos.yaml"))
+    obstacle = load_obstacle(str(package / "config" / "sim.yaml"))
+    radius = tool_radius(str(package / "config" / "description.args"))
+    assert obstacle is not None
+    # The tip over the obstacle's centre at the package's stated gap is checked end to end; here the
+    # obstacle must at least be reachable by the compliant move from above.
+    assert obstacle.size[0] / 2 > radius and obstacle.size[1] / 2 > radius
+    assert g.compliant_max_travel > 0.045
