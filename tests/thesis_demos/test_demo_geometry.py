@@ -89,9 +89,19 @@ def test_preflight_names_a_hybrid_path_through_the_obstacle():
     assert "run into the obstacle" in problems["hybrid"]
 
 
-def test_preflight_without_obstacle_refuses_only_the_compliant_move():
+def test_preflight_without_obstacle_refuses_only_the_demos_that_press_on_it():
     problems = preflight(DemoGeometry(), (0.6, 0.1, 0.20), None)
-    assert list(problems) == ["compliant_move_z"]
+    assert sorted(problems) == ["compliant_move_z", "surface_following"]
+
+
+def test_surface_following_needs_a_block_the_tool_stays_on_over_its_slide():
+    from thesis_demos.geometry import Obstacle
+
+    wide = Obstacle(position=(0.6, 0.1, 0.065), size=(0.15, 0.15, 0.13))
+    narrow = Obstacle(position=(0.6, 0.1, 0.065), size=(0.11, 0.11, 0.13))
+    assert "surface_following" not in preflight(DemoGeometry(), (0.6, 0.1, 0.20), wide, tool_radius=0.03)
+    reason = preflight(DemoGeometry(), (0.6, 0.1, 0.20), narrow, tool_radius=0.03)["surface_following"]
+    assert "60 mm wide" in reason and "11 x 11 cm" in reason
 
 
 @pytest.mark.parametrize("package", ROBOT_PACKAGES, ids=lambda p: p.name)

@@ -40,6 +40,9 @@ SCENE_FILE = os.path.join("config", "sim.yaml")
 MIN_APPROACH = 0.025
 # Room kept between the obstacle and the end of the compliant move's max path deviation [m].
 APPROACH_MARGIN = 0.02
+# Surface following (the fifth demonstration) slides the tool this far along X on the obstacle's top.
+SURFACE_TRAVEL = 0.04  # [m]
+SURFACE_DIRECTION = -1  # along X: toward the base
 # The hybrid move's tool tip passes at least this high over the obstacle's top [m].
 PASSING_CLEARANCE = 0.02
 
@@ -339,6 +342,16 @@ def preflight(
                 f"the hybrid move along {'+' if geometry.hybrid_direction > 0 else '-'}X at z = {z:.3f} m "
                 f"would run into the obstacle (top at {obstacle.top:.3f} m)"
             )
+    if obstacle is not None and geometry.compliant_direction < 0:
+        x_end = x + SURFACE_DIRECTION * SURFACE_TRAVEL
+        if not (obstacle.covers(x, y, tool_radius) and obstacle.covers(x_end, y, tool_radius)):
+            problems["surface_following"] = (
+                f"the tool ({tool_radius * 2000:.0f} mm wide) would not stay on the obstacle's top "
+                f"({obstacle.size[0] * 100:.0f} x {obstacle.size[1] * 100:.0f} cm) over the "
+                f"{SURFACE_TRAVEL * 100:.0f} cm slide from ({x:.3f}, {y:.3f}) m: it needs a larger block"
+            )
+    elif obstacle is None or geometry.compliant_direction > 0:
+        problems["surface_following"] = "it presses down on the scene's obstacle: there is none below the tip"
     if z < 0.03:
         for demo in ("follower_z", "spring_x", "hybrid"):
             problems.setdefault(

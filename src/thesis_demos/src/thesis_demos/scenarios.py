@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from thesis_demos.geometry import DemoGeometry
+from thesis_demos.geometry import SURFACE_DIRECTION, SURFACE_TRAVEL, DemoGeometry
 
 __all__ = ["SCENARIOS", "AxisLaw", "FollowUp", "Push", "Scenario", "build_scenarios", "by_name"]
 
@@ -168,8 +168,7 @@ SURFACE_DAMPING = 2000.0  # [N/(m/s)] b against ~20 N/mm of a stiff arm on a blo
 # a simulated arm (the filtered force and the arm lag ~70 ms behind the contact) and tripped the 25 N limit.
 SURFACE_APPROACH_SPEED = 0.005
 SURFACE_FORCE_LIMIT = 20.0  # [N] ends the press (move_away) well under the 25 N global limit
-SURFACE_TRAVEL = 0.04  # [m] along X over the block's top
-SURFACE_VELOCITY = -0.01  # [m/s] along X (toward the base: clear on both robots, see hybrid)
+SURFACE_VELOCITY = SURFACE_DIRECTION * 0.01  # [m/s] along X (toward the base: clear on both robots)
 SURFACE_SETTLE = 0.5  # [s] after X starts, left out of the figures (X speeding up, friction building up)
 
 _PRESS = AxisLaw(
