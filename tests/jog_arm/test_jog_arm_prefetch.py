@@ -1,9 +1,10 @@
-"""Work done ahead or cached per joint state (prefetch, measured_frame_pose) must never change an answer."""
+"""Work done ahead or cached per joint state (prefetch, ModelFrames) must never change an answer."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+from jog_arm.model_frames import ModelFrames
 from jog_arm_testing import Robot, make_jog
 
 
@@ -48,15 +49,16 @@ def test_prefetch_gives_the_commands_of_computing_in_the_cycle(robot: Robot, int
     assert min(row[-1] for row in plain) < 1.0, "the run never came near the singularity it should test"
 
 
-def test_measured_frame_pose_follows_each_new_joint_state(robot: Robot) -> None:
+def test_model_frames_follow_each_new_joint_state(robot: Robot) -> None:
     jog = make_jog(robot)
+    frames = ModelFrames(jog.model, lambda: jog.measured)
     with pytest.raises(LookupError):
-        jog.measured_frame_pose(robot.tip, robot.planning_frame)
-    assert jog.measured_frame_pose("no_such_frame", robot.planning_frame) is None
+        frames.pose(robot.tip, robot.planning_frame)
+    assert frames.pose("no_such_frame", robot.planning_frame) is None
     for q in (robot.start, robot.near_singular):
         jog.set_joint_state(q)
         for _ in range(2):  # the second answer comes from the per-state cache
-            pose = np.array(jog.measured_frame_pose(robot.tip, robot.planning_frame))
+            pose = np.array(frames.pose(robot.tip, robot.planning_frame))
             expected = jog.eef_pose(q)  # tip in the planning frame, computed afresh
             assert pose[:3, :3] == pytest.approx(expected.rotation, abs=1e-12)
             assert pose[:3, 3] == pytest.approx(expected.translation, abs=1e-12)

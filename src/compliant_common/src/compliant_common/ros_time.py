@@ -10,21 +10,7 @@ import rospy
 
 from compliant_common.clock import ClockJump, ClockWatch
 
-__all__ = ["JumpAwareClock", "sleep_through_jumps", "timer"]
-
-
-def sleep_through_jumps(duration: float) -> bool:
-    """`rospy.sleep(duration)`; False if the clock jumped back meanwhile (rospy raises then, which ends the
-    thread that called it unless caught), True otherwise.
-
-    Raises:
-        rospy.ROSInterruptException: shutdown.
-    """
-    try:
-        rospy.sleep(duration)
-    except rospy.ROSTimeMovedBackwardsException:
-        return False
-    return True
+__all__ = ["JumpAwareClock", "timer"]
 
 
 def timer(period: float, callback: Callable[[Any], None]) -> rospy.Timer:

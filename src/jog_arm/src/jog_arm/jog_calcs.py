@@ -228,9 +228,6 @@ class JogCalcs:
         self._names_cache: tuple[tuple[str, ...], list[int]] = ((), [])
         self._zeros = (0.0,) * n
         self._out = JogOutput(n)
-        self._pose_ids: dict[tuple[str, str], tuple[int, int]] = {}
-        self._poses: dict[tuple[str, str], list[list[float]]] = {}  # at the joint state _poses_q
-        self._poses_q: object = None
         self._geom = _Geometry()
 
     # --- inputs ---------------------------------------------------------------------------------------
@@ -399,6 +396,12 @@ class JogCalcs:
         self._cmd_zero = True
 
     @property
+    def measured(self) -> list[float] | None:
+        """The last measured joint positions in model order (a new list per joint state; do not modify),
+        None before the first."""
+        return self._q_meas if self._have_state else None
+
+    @property
     def paused(self) -> bool:
         """Whether :meth:`pause` is in effect."""
         return self._paused
@@ -406,7 +409,7 @@ class JogCalcs:
     # --- the cycle ------------------------------------------------------------------------------------
 
     def step(self, now: float) -> JogOutput:
-        """Runs one control cycle.
+        """Runs one control cycle: what to follow, then the stages follow -> limit -> integrate.
 
         Args:
             now: Current time [s], same clock as the `now` given to :meth:`set_command`.
@@ -415,121 +418,30 @@ class JogCalcs:
             The shared :class:`JogOutput` (overwritten by the next call).
         """
         out = self._out
-        settings = self.settings
         if not self._have_state:
             out.publish = False
             out.status = StatusCode.NO_JOINT_STATE
             out.message = "no joint state received yet"
             out.speed_scale = 0.0
             return out
-
         # 1. Reference configuration (plain float lists: cheaper than numpy for 6-7 values).
         q_ref, resynced = self._reference()
-
-        # What to follow.
-        status = StatusCode.NO_WARNING
-        message = ""
-        state_time = self._state_time
-        if self._paused:
-            status, message = StatusCode.PAUSED, "paused"
-        elif self._suspended:
-            status, message = StatusCode.PAUSED, f"suspended: {self._suspended}"
-        elif state_time is not None and now - state_time > settings.joint_state_timeout:
-            status = StatusCode.STALE_JOINT_STATE
-            message = (
-                f"no joint state for {now - state_time:.3f} s (joint_state_timeout): stopping"
-                if state_time > -math.inf
-                else "waiting for a joint state received after the clock jump"
-            )
-        elif self._rejected:
-            status, message = StatusCode.INVALID_COMMAND, f"command rejected: {self._rejected}"
-        elif self._cmd_time is None:
-            status, message = StatusCode.STALE_COMMAND, self._drop_reason or "no command received yet"
-        elif now - self._cmd_time > settings.incoming_cmd_timeout:
-            status = StatusCode.STALE_COMMAND
-            message = f"no command for {now - self._cmd_time:.3f} s (incoming_cmd_timeout)"
-        elif self._cmd_zero:
-            message = "zero command"
+        status, message = self._command_state(now)
         follow = status == StatusCode.NO_WARNING and not self._cmd_zero
-
-        dq_out = self._dq_out
-        if not follow and not any(dq_out):
+        if not follow and not any(self._dq_out):
             return self._hold(q_ref, status, message)
-
-        # 2. Jacobian, condition number, factorised damped J·Jᵀ (computed ahead by prefetch() if it could).
-        geometry = self._geometry(q_ref)
-        q_arr, J, condition = geometry.q_arr, geometry.J, geometry.condition
-        if not self._running:
-            self._running = True
-            if not self._posture_fixed:
-                np.multiply(q_arr, self._ns_gain, out=self._gain_posture)
-        out.condition_number = condition
-
-        s_sing = 1.0
-        if follow:
-            # 3. Twist in root axes, damped pseudo-inverse J⁺ = Jᵀ(JJᵀ + λ²I)⁻¹ (Cholesky solve),
-            # null-space pull: dq = J⁺x + (I - J⁺J)·pull = J⁺(x - J·pull) + pull.
-            x = self._twist_weighted
-            frame = self._cmd_frame
-            if frame.static is None:
-                rot = self.model.frame_rotation(frame.frame_id, None if frame.on_chain else q_arr)
-                if frame.extra is not None:
-                    rot = rot @ frame.extra
-                np.dot(rot, self._twist[:3], out=x[:3])
-                np.dot(rot, self._twist[3:], out=x[3:])
-                x *= self._row_weights
-            llt = self._llt
-            if self._redundant:
-                pull = self._gain_posture - self._ns_gain * q_arr
-                dq_arr = J.T @ llt.solve(x - J @ pull)
-                dq_arr += pull
-            else:
-                dq_arr = J.T @ llt.solve(x)
-            # 4. Singularity: scale only motion that makes the condition number grow.
-            if condition > settings.singularity_threshold:
-                toward = self._predicted_condition(q_arr, dq_arr) > condition
-                s_sing = singularity_scale(
-                    condition,
-                    settings.singularity_threshold,
-                    settings.hard_stop_singularity_threshold,
-                    toward,
-                )
-                dq_arr *= s_sing
-            # 5. Low-pass filter, started from the current output so there is no start-up jump.
-            if not self._filter_live:
-                self._filter.reset(dq_out)
-                self._filter_live = True
-            dq = self._filter.filter(dq_arr.tolist())
-        else:
-            dq = [0.0] * self.nv
-            self._filter_live = False
-
-        # 6. Limits, each scaling the whole vector.
-        limiter = self.limiter
-        s_pos = limiter.position_scale(q_ref, dq)
-        s_vel = (
-            limiter.velocity_scale(dq) if s_pos == 1.0 else limiter.velocity_scale([v * s_pos for v in dq])
-        )
-        scale = s_pos * s_vel
-        if scale < 1.0:
-            dq = [v * scale for v in dq]
-        dq_new, limited = limiter.limit_acceleration(dq_out, dq)
-        if limited:  # slowing down slower than asked might cross a stop: position beats acceleration
-            guard = limiter.step_scale(q_ref, dq_new)
-            if guard < 1.0:
-                dq_new = [v * guard for v in dq_new]
-        if not follow and max(map(abs, dq_new)) < 1e-9:
-            dq_new = [0.0] * self.nv
-        self._dq_out = dq_new
-
+        # 2.-5. Joint velocity for the twist (zero when there is nothing to follow).
+        dq, condition, s_sing = self._follow(q_ref) if follow else self._no_follow(q_ref)
+        # 6. Position, velocity and acceleration limits.
+        dq_new, s_pos, s_vel = self._limit(q_ref, dq, follow)
         # 7. Integrate over the publish period.
-        period = self._period
-        self._q_cmd = q_cmd = [q + v * period for q, v in zip(q_ref, dq_new, strict=True)]
+        q_cmd = self._integrate(q_ref, dq_new)
 
+        out.condition_number = condition
         if follow:
             self._zero_sent = 0
             status, message = self._motion_status(condition, s_sing, s_pos, s_vel)
-            out.speed_scale = s_sing * scale
+            out.speed_scale = s_sing * s_pos * s_vel
         else:
             out.speed_scale = 0.0
             if not any(dq_new):
@@ -544,6 +456,111 @@ class JogCalcs:
         out.status = status
         out.message = message
         return out
+
+    def _command_state(self, now: float) -> tuple[StatusCode, str]:
+        """Whether there is a command to follow now: NO_WARNING, or the reason there is none."""
+        settings = self.settings
+        state_time = self._state_time
+        if self._paused:
+            return StatusCode.PAUSED, "paused"
+        if self._suspended:
+            return StatusCode.PAUSED, f"suspended: {self._suspended}"
+        if state_time is not None and now - state_time > settings.joint_state_timeout:
+            message = (
+                f"no joint state for {now - state_time:.3f} s (joint_state_timeout): stopping"
+                if state_time > -math.inf
+                else "waiting for a joint state received after the clock jump"
+            )
+            return StatusCode.STALE_JOINT_STATE, message
+        if self._rejected:
+            return StatusCode.INVALID_COMMAND, f"command rejected: {self._rejected}"
+        if self._cmd_time is None:
+            return StatusCode.STALE_COMMAND, self._drop_reason or "no command received yet"
+        if now - self._cmd_time > settings.incoming_cmd_timeout:
+            age = now - self._cmd_time
+            return StatusCode.STALE_COMMAND, f"no command for {age:.3f} s (incoming_cmd_timeout)"
+        return StatusCode.NO_WARNING, "zero command" if self._cmd_zero else ""
+
+    def _start_running(self, q_arr: np.ndarray) -> None:
+        if not self._running:
+            self._running = True
+            if not self._posture_fixed:
+                np.multiply(q_arr, self._ns_gain, out=self._gain_posture)
+
+    def _no_follow(self, q_ref: list[float]) -> tuple[list[float], float, float]:
+        """Decelerating with nothing to follow: target zero (the condition number still reported)."""
+        geometry = self._geometry(q_ref)
+        self._start_running(geometry.q_arr)
+        self._filter_live = False
+        return [0.0] * self.nv, geometry.condition, 1.0
+
+    def _follow(self, q_ref: list[float]) -> tuple[list[float], float, float]:
+        """Stages 2-5: the filtered joint velocity for the twist, the condition number and the singularity
+        scale applied."""
+        settings = self.settings
+        # 2. Jacobian, condition number, factorised damped J·Jᵀ (computed ahead by prefetch() if it could).
+        geometry = self._geometry(q_ref)
+        q_arr, J, condition = geometry.q_arr, geometry.J, geometry.condition
+        self._start_running(q_arr)
+        # 3. Twist in root axes, damped pseudo-inverse J⁺ = Jᵀ(JJᵀ + λ²I)⁻¹ (Cholesky solve),
+        # null-space pull: dq = J⁺x + (I - J⁺J)·pull = J⁺(x - J·pull) + pull.
+        x = self._twist_weighted
+        frame = self._cmd_frame
+        assert frame is not None  # a command is being followed
+        if frame.static is None:
+            rot = self.model.frame_rotation(frame.frame_id, None if frame.on_chain else q_arr)
+            if frame.extra is not None:
+                rot = rot @ frame.extra
+            np.dot(rot, self._twist[:3], out=x[:3])
+            np.dot(rot, self._twist[3:], out=x[3:])
+            x *= self._row_weights
+        llt = self._llt
+        if self._redundant:
+            pull = self._gain_posture - self._ns_gain * q_arr
+            dq_arr = J.T @ llt.solve(x - J @ pull)
+            dq_arr += pull
+        else:
+            dq_arr = J.T @ llt.solve(x)
+        # 4. Singularity: scale only motion that makes the condition number grow.
+        s_sing = 1.0
+        if condition > settings.singularity_threshold:
+            toward = self._predicted_condition(q_arr, dq_arr) > condition
+            s_sing = singularity_scale(
+                condition, settings.singularity_threshold, settings.hard_stop_singularity_threshold, toward
+            )
+            dq_arr *= s_sing
+        # 5. Low-pass filter, started from the current output so there is no start-up jump.
+        if not self._filter_live:
+            self._filter.reset(self._dq_out)
+            self._filter_live = True
+        return self._filter.filter(dq_arr.tolist()), condition, s_sing
+
+    def _limit(self, q_ref: list[float], dq: list[float], follow: bool) -> tuple[list[float], float, float]:
+        """Stage 6: position, velocity, then acceleration limits, each scaling the whole vector; the new
+        output velocity with the position and velocity scales."""
+        limiter = self.limiter
+        s_pos = limiter.position_scale(q_ref, dq)
+        s_vel = (
+            limiter.velocity_scale(dq) if s_pos == 1.0 else limiter.velocity_scale([v * s_pos for v in dq])
+        )
+        scale = s_pos * s_vel
+        if scale < 1.0:
+            dq = [v * scale for v in dq]
+        dq_new, limited = limiter.limit_acceleration(self._dq_out, dq)
+        if limited:  # slowing down slower than asked might cross a stop: position beats acceleration
+            guard = limiter.step_scale(q_ref, dq_new)
+            if guard < 1.0:
+                dq_new = [v * guard for v in dq_new]
+        if not follow and max(map(abs, dq_new)) < 1e-9:
+            dq_new = [0.0] * self.nv
+        self._dq_out = dq_new
+        return dq_new, s_pos, s_vel
+
+    def _integrate(self, q_ref: list[float], dq: list[float]) -> list[float]:
+        """Stage 7: positions = reference + velocity x pub_period."""
+        period = self._period
+        self._q_cmd = q_cmd = [q + v * period for q, v in zip(q_ref, dq, strict=True)]
+        return q_cmd
 
     def prefetch(self) -> None:
         """Computes the next cycle's twist-independent part now (Jacobian, condition number, factorisation),
@@ -693,31 +710,6 @@ class JogCalcs:
             q[self._to_user] = np.asarray(positions, dtype=float)
         self._geom.valid = False  # frame_pose moves the model's data
         return self.model.frame_pose(q, self.settings.ee_frame_name, self.settings.planning_frame)
-
-    def measured_frame_pose(self, frame: str, relative_to: str) -> list[list[float]] | None:
-        """Pose (4x4 rows) of model frame `frame` in model frame `relative_to` at the last measured joint
-        state; None if either is not a frame of the model. Computed once per joint state (callers must not
-        modify the rows).
-
-        Raises:
-            LookupError: No joint state received yet.
-        """
-        if not (self.model.has_frame(frame) and self.model.has_frame(relative_to)):
-            return None
-        if not self._have_state:
-            raise LookupError("no joint state received yet")
-        q = self._q_meas
-        if q is not self._poses_q:  # a new joint state: earlier answers are out of date
-            self._poses.clear()
-            self._poses_q = q
-        key = (frame, relative_to)
-        pose = self._poses.get(key)
-        if pose is None:
-            ids = self._pose_ids.get(key)
-            if ids is None:
-                ids = self._pose_ids[key] = (self.model.frame_id(frame), self.model.frame_id(relative_to))
-            pose = self._poses[key] = self.model.measured_pose(q, *ids).tolist()
-        return pose
 
     def _resolve_frame(self, name: str) -> _Frame | None:
         frame = self._frames.get(name)

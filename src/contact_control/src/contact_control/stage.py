@@ -1,0 +1,276 @@
+"""ContactStage: contact_control without ROS: a wrench (and the frames it needs) in, a twist out.
+
+Around one `ContactControl` it keeps what the node used to: which frames a cycle needs (each looked up once
+per cycle), the rotation of the twist into `velocity_command_frame`, the publish policy (twists while a move
+or an exceeded action runs, then `idle_zero_count` zeros, then silence so other sources can use the topic),
+the stale-data timing (`tick`, `next_due`), requests (validated, answered with the reason), and the notes
+shown on `~status`. No rospy: the node (contact_control_node, or control_stack's pipeline) brings the
+frames as a `PoseSource` and publishes what comes out.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from typing import Any, NamedTuple
+
+from contact_control.axes import (
+    AXES,
+    EXCEEDED_ACTION_NAMES,
+    LAW_COMPLIANT_MOVE,
+    LAW_FORCE_TRACKING,
+    LAW_NAMES,
+    SAFETY_NO_TF,
+)
+from contact_control.controller import ContactControl, CycleResult
+from contact_control.frames import IDENTITY, compose, inverse, rotate_twist, rotation, transpose_times
+from contact_control.params import ContactControlSettings
+from contact_control.request import (
+    SUCCESS,
+    RequestError,
+    RequestLimits,
+    validate_laws_request,
+    validate_request,
+)
+
+__all__ = ["Answer", "ContactStage", "PoseSource", "Velocity", "describe_laws"]
+
+#: frame -> its pose in `fixed_frame` (4x4 rows); raises LookupError when it cannot answer (yet).
+PoseSource = Callable[[str], "list[list[float]]"]
+Velocity = tuple[float, float, float, float, float, float]  # a twist in velocity_command_frame
+
+ZERO: Velocity = (0.0,) * 6  # type: ignore[assignment]
+FAULT_SHOWN_FOR = 1.0  # [s] a clock jump stays on ~status at least this long, so a 50 Hz reader sees it
+
+
+class Answer(NamedTuple):
+    """The answer to a request: accepted, its code (request.SUCCESS or why not), the laws in words or the
+    reason for refusing, and the move id (0 when refused)."""
+
+    ok: bool
+    code: int
+    message: str
+    move_id: int
+
+
+class ContactStage:
+    """One `ContactControl` with its frames, publish policy and timing; see the module docstring.
+
+    Not thread-safe: the node holds one lock around every call.
+
+    Args:
+        settings: Validated parameters.
+        poses: Where frames come from (the robot model in control_stack, tf in a node of its own).
+        monotonic: The monotonic clock (how long a fault stays on the status).
+    """
+
+    def __init__(
+        self,
+        settings: ContactControlSettings,
+        poses: PoseSource,
+        monotonic: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self.settings = s = settings
+        self.ctrl = ContactControl(settings)
+        self.limits = RequestLimits.from_settings(settings)
+        self._poses = poses
+        self._monotonic = monotonic
+        self._gravity = s.tool_mass > 0.0
+        self._period = 1.0 / s.control_rate
+        self._idle_zeros = 0
+        self._was_active = False
+        self._stale = False  # the last tick found the data stale (then it runs every period)
+        self._last_tick = -float("inf")
+        self._request_note = ""
+        self._fault_note = ""  # a clock jump or a lost master, for ~status until it is over
+        self._fault_shown_until = 0.0
+        self._cycle_poses: dict[str, list[list[float]]] = {}
+        self._last_raw: Sequence[float] = ZERO
+        self._last_frames: tuple[Any, Any] = (None, None)  # T_control_sensor, R_world_sensor of that wrench
+        self._have_frames = False
+        self._last_t = 0.0
+        #: The latest compensated, unfiltered contact force ((fx, fy, fz) [N], control frame, t [s]) or None.
+        self.contact: tuple[tuple[float, float, float], str, float] | None = None
+        #: A move ended or was replaced since the node last cleared it (wakes blocking callers).
+        self.ended = False
+        #: (level, text) for the node's log, drained by it.
+        self.notes: list[tuple[str, str]] = []
+
+    # --- frames ---
+    def _pose(self, frame: str) -> list[list[float]]:
+        """Pose of `frame` in the fixed frame, looked up at most once per cycle."""
+        pose = self._cycle_poses.get(frame)
+        if pose is None:
+            pose = IDENTITY if frame == self.settings.fixed_frame else self._poses(frame)
+            self._cycle_poses[frame] = pose
+        return pose
+
+    def _frames(self, sensor_frame: str) -> tuple[Any, Any, Any, Any, Any]:
+        """(T_control_sensor, R_world_sensor, T_fixed_eef, R_fixed_control, R_command_control) for one cycle;
+        None stands for "same frame" or "not needed".
+
+        Raises:
+            LookupError: A frame is not available.
+        """
+        s = self.settings
+        self._cycle_poses.clear()
+        T_fixed_control = self._pose(s.control_frame)
+        R_fixed_control = None if s.control_frame == s.fixed_frame else rotation(T_fixed_control)
+        T_control_sensor = None
+        if sensor_frame != s.control_frame:
+            T_fixed_sensor = self._pose(sensor_frame)
+            if R_fixed_control is None:
+                T_control_sensor = T_fixed_sensor
+            else:
+                T_control_sensor = compose(inverse(T_fixed_control), T_fixed_sensor)
+        R_world_sensor = rotation(self._pose(sensor_frame)) if self._gravity else None
+        eef = self._pose(s.eef_frame) if self.ctrl.needs_travel else None
+        R_command_control = None
+        if s.velocity_command_frame != s.control_frame:
+            R_fixed_command = rotation(self._pose(s.velocity_command_frame))
+            R_command_control = transpose_times(R_fixed_command, rotation(T_fixed_control))
+        return T_control_sensor, R_world_sensor, eef, R_fixed_control, R_command_control
+
+    def sensor_rotation(self) -> list[list[float]]:
+        """The sensor frame's orientation in the fixed frame now (3x3 rows; for payload samples).
+
+        Raises:
+            LookupError: Not available.
+        """
+        self._cycle_poses.clear()
+        return [row[:3] for row in self._pose(self.settings.ft_sensor_frame)[:3]]
+
+    # --- data ---
+    def on_wrench(
+        self, wrench: Sequence[float], frame: str, stamp: float | None, t: float
+    ) -> Velocity | None:
+        """One cycle for a wrench (fx, fy, fz, tx, ty, tz) [N, Nm] in `frame` ("": ft_sensor_frame) with
+        header time `stamp` (None: unstamped) received at `t` [s]; the twist to send, if one is due."""
+        s = self.settings
+        sensor_frame = ("" if s.use_ft_sensor_frame else frame) or s.ft_sensor_frame
+        self._have_frames = False
+        try:
+            T_cs, R_ws, eef, R_fc, R_cc = self._frames(sensor_frame)
+        except LookupError as err:
+            return self._emit(self.ctrl.hold(t, SAFETY_NO_TF, f"no transform: {err}"))
+        velocity = self._emit(self.ctrl.update(wrench, t, T_cs, R_ws, eef, R_fc, stamp), R_cc)
+        if self.ctrl.notes:  # the sensor's measured rate, once per change
+            self.notes.extend(("warn", note) for note in self.ctrl.notes)
+            self.ctrl.notes.clear()
+        self._last_raw, self._last_frames, self._have_frames = wrench, (T_cs, R_ws), True
+        self._last_t = t
+        return velocity
+
+    def update_contact(self) -> tuple[tuple[float, float, float], str, float] | None:
+        """The compensated contact force of the last wrench (for jog_arm's contact guard), computed off the
+        wrench-to-twist path: call it after sending the twist. Kept while the global limit is latched (the
+        guard needs it most)."""
+        if self._have_frames:
+            self._have_frames = False
+            force = self.ctrl.contact_force(self._last_raw, *self._last_frames)
+            if force is not None:
+                self.contact = (force, self.settings.control_frame, self._last_t)
+        return self.contact
+
+    # --- time ---
+    def next_due(self) -> float:
+        """When `tick` has work [s]: when the newest wrench turns stale, then every 1/control_rate while data
+        is missing (zeros for jog_arm, the move's end after no_data_end_timeout)."""
+        again = self._last_tick + self._period
+        return again if self._stale else max(self.ctrl.fresh_until, again)
+
+    def tick(self, t: float) -> Velocity | None:
+        """The stale-data check at `t`; the twist to send, if one is due."""
+        self._last_tick = t
+        result = self.ctrl.check_stale(t)
+        self._stale = result is not None
+        return None if result is None else self._emit(result)
+
+    def clock_jumped(self, note: str, t: float) -> Velocity | None:
+        """Halts and restarts the timing; the move resumes with the next wrench stamped after the jump."""
+        self.notes.append(("warn", f"{note}: holding (zero twist) until fresh data"))
+        self._fault_note = note
+        self._fault_shown_until = self._monotonic() + FAULT_SHOWN_FOR
+        self._last_tick = -float("inf")
+        return self._emit(self.ctrl.clock_jumped(t, note))
+
+    def master_lost(self, reason: str) -> Velocity | None:
+        """The graph is broken: the running move ends (one zero twist to send)."""
+        self._fault_note = reason
+        return self.stop(reason)
+
+    def master_back(self) -> None:
+        self._fault_note = ""
+
+    # --- publish policy ---
+    def _emit(self, result: CycleResult, R_command_control: Any = None) -> Velocity | None:
+        """The twist to send for a cycle's result, per the publish policy; notes a move's end."""
+        velocity: Velocity | None = None
+        if result.commanding:  # a move, or an exceeded action after it (moving away, hand-guiding)
+            self._idle_zeros = int(self.settings.idle_zero_count)
+            v = result.velocity
+            if R_command_control is not None and any(v):
+                v = rotate_twist(R_command_control, v)
+            velocity = tuple(v)  # type: ignore[assignment]
+        elif self._was_active:
+            self.ended = True
+            velocity = ZERO  # at least one zero right away, whatever idle_zero_count says
+        elif self._idle_zeros > 0:
+            self._idle_zeros -= 1
+            velocity = ZERO
+        elif self.settings.publish_when_idle:
+            velocity = ZERO
+        self._was_active = result.commanding
+        return velocity
+
+    # --- requests ---
+    def configure(self, req: Any, t: float, per_axis: bool = False) -> Answer:
+        """Validates and applies a ConfigureForceControl (or, `per_axis`, a ConfigureLaws) request:
+        (accepted, code, the laws in words or the reason for refusing)."""
+        validate = validate_laws_request if per_axis else validate_request
+        try:
+            laws = validate(req, self.limits)
+            move_id = self.ctrl.set_laws(laws, None, t)
+        except RequestError as err:
+            self._request_note = f"last request refused (code {err.code}): {err.message}"
+            return Answer(False, err.code, err.message, 0)
+        self._request_note = ""
+        self._idle_zeros = int(self.settings.idle_zero_count)
+        self.ended = True  # a blocking caller of a replaced move answers now
+        return Answer(True, SUCCESS, describe_laws(move_id, laws), move_id)
+
+    def stop(self, reason: str) -> Velocity | None:
+        """Ends the running move; a zero twist to send if one was running."""
+        if not self.ctrl.stop(reason):
+            return None
+        self.ended = True
+        self._was_active = False
+        self._idle_zeros = int(self.settings.idle_zero_count)
+        return ZERO
+
+    # --- status ---
+    def status(self) -> tuple[CycleResult, str]:
+        """The last cycle's result and the status message (fault, cycle, refused request)."""
+        r = self.ctrl.last_result
+        fault = self._fault_note
+        over = r.safety == 0 and self._monotonic() > self._fault_shown_until
+        if fault and over and not fault.startswith("ROS master"):  # the jump is over
+            self._fault_note = fault = ""
+        return r, "; ".join(m for m in (fault, r.message, self._request_note) if m)
+
+
+def describe_laws(move_id: int, laws: Sequence[Any]) -> str:
+    """The accepted laws in words, e.g. "contact laws set (move 3): z=compliant_move (v -0.01, move_away)".
+
+    A compliant move shows its velocity: it may be the default one, in the direction the node chose.
+    """
+    parts = []
+    for i, law in enumerate(laws):
+        if law.law:
+            notes = [f"v {law.velocity:g}"] if law.law == LAW_COMPLIANT_MOVE else []
+            if law.law == LAW_FORCE_TRACKING:
+                notes = [f"target {law.target:g}", f"b {law.damping:g}", f"approach {law.velocity:g}"]
+            if law.exceeded_action:
+                notes.append(EXCEEDED_ACTION_NAMES[law.exceeded_action])
+            parts.append(f"{AXES[i]}={LAW_NAMES[law.law]}" + (f" ({', '.join(notes)})" if notes else ""))
+    return f"contact laws set (move {move_id}): {', '.join(parts) or 'none (all axes still)'}"

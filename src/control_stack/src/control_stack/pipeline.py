@@ -1,0 +1,199 @@
+"""CompliantPipeline: the wrench-to-joint-command chain of one arm, with no ROS (see the package README).
+
+The data path, top to bottom:
+
+    joint state --------------------------------------------> jog stage (measured q) --> model frames
+    wrench ---> contact stage (frames from the model) ---> twist ---> jog stage ---> joint command
+    outside twist (keyboard, GUI) ---> contact guard -------------> jog stage ---> joint command
+    tick (time) ---> stale wrench: zero twist / halt ---------------> jog stage ---> gap fill / rate cycle
+
+Every timing rule is here or in the two stages it calls: the clock-jump check on each input, the contact
+stage's stale-data schedule, the jog stage's cycle schedule, and `next_due` that joins them. A node only
+reads the clock, calls in under one lock, publishes what comes out and sleeps until `next_due`.
+"""
+
+from __future__ import annotations
+
+import collections
+import time
+from collections.abc import Callable, Sequence
+
+from compliant_common.clock import ClockWatch
+from contact_control.params import ContactControlSettings
+from contact_control.stage import ZERO, ContactStage, PoseSource, Velocity
+from jog_arm.settings import JogSettings
+from jog_arm.stage import JogCycle, JogStage
+
+__all__ = ["CompliantPipeline", "PipelineOutput"]
+
+ECHOES_KEPT = 16  # own twists remembered to recognise their copies coming back over the topic
+
+
+class PipelineOutput:
+    """What one call produced. One instance per pipeline, refilled by each call.
+
+    Attributes:
+        twist: contact_control's twist (velocity_command_frame) to publish for observers, or None.
+        cycle: The jog cycle that ran (its joint command if `cycle.publish`), or None.
+    """
+
+    __slots__ = ("cycle", "twist")
+
+    def __init__(self) -> None:
+        self.twist: Velocity | None = None
+        self.cycle: JogCycle | None = None
+
+
+class CompliantPipeline:
+    """contact_control -> jog_arm for one arm, in-process; see the module docstring.
+
+    Not thread-safe: the node holds one lock around every call, and reads each call's time `t` under it
+    (every input's `t` is checked for a clock jump against the monotonic clock read in the call: a time
+    read before waiting for the lock would look like a step back).
+
+    Args:
+        contact: contact_control's settings.
+        jog: jog_arm's settings.
+        urdf_xml: The robot description.
+        outside_poses: Poses (in contact's fixed frame) of frames the robot model lacks, e.g. from tf;
+            None: such frames are unavailable.
+        monotonic: The monotonic clock.
+
+    Raises:
+        KinematicsError, SettingsError: jog_arm's configuration does not fit the robot model.
+    """
+
+    def __init__(
+        self,
+        contact: ContactControlSettings,
+        jog: JogSettings,
+        urdf_xml: str,
+        outside_poses: PoseSource | None = None,
+        monotonic: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self._monotonic = monotonic
+        self._outside = outside_poses
+        self._fixed = contact.fixed_frame
+        self.contact = ContactStage(contact, self._pose, monotonic)
+        # The guard on outside twists reads contact_control's compensated force, in-process.
+        self.jog = JogStage(jog, urdf_xml, lambda: self.contact.contact, monotonic)
+        self._twist_frame = contact.velocity_command_frame
+        self._clock = ClockWatch(stop_tolerance=max(0.5, 2.0 * jog.incoming_cmd_timeout))
+        self._sent: collections.deque[tuple[float, Velocity]] = collections.deque(maxlen=ECHOES_KEPT)
+        self._out = PipelineOutput()
+
+    def frames_from_outside(self) -> list[str]:
+        """The configured frames the robot model lacks (they need `outside_poses`)."""
+        s = self.contact.settings
+        wanted = {s.control_frame, s.ft_sensor_frame, s.eef_frame, s.velocity_command_frame} - {self._fixed}
+        return sorted(f for f in wanted if not self.jog.frames.has(f, self._fixed))
+
+    def _pose(self, frame: str) -> list[list[float]]:
+        pose = self.jog.frames.pose(frame, self._fixed)
+        if pose is not None:
+            return pose
+        if self._outside is None:
+            raise LookupError(f"{frame!r} is not a frame of the robot model")
+        return self._outside(frame)
+
+    # --- inputs ---
+    def on_joint_state(self, names: Sequence[str], positions: Sequence[float], t: float) -> PipelineOutput:
+        """A joint state received at `t` [s]."""
+        out = self._check_clock(t)
+        self.jog.on_joint_state(names, positions, t)
+        return out
+
+    def on_wrench(
+        self, wrench: Sequence[float], frame: str, stamp: float | None, t: float
+    ) -> PipelineOutput:
+        """A wrench in `frame` with header time `stamp` (None: unstamped) received at `t` [s]: the contact
+        laws' twist, and at once the joint command for it (publish_on_command)."""
+        out = self._check_clock(t)
+        if out.twist is not None:  # the clock jumped: this wrench belongs to the old time
+            return out
+        self._to_jog(self.contact.on_wrench(wrench, frame, stamp, t), t, out)
+        return out
+
+    def from_contact(self, twist: Velocity | None, t: float) -> PipelineOutput:
+        """A twist contact_control made outside a wrench or a tick (a stop request's zero), for jog_arm."""
+        out = self._out
+        out.twist = out.cycle = None
+        self._to_jog(twist, t, out)
+        return out
+
+    def _to_jog(self, twist: Velocity | None, t: float, out: PipelineOutput) -> None:
+        """contact_control's twist (if any) -> jog_arm, as an inside command (no contact guard)."""
+        if twist is not None:
+            self._sent.append((t, twist))
+            out.twist = twist
+            out.cycle = self.jog.on_twist(twist, self._twist_frame, t, outside=False)
+
+    def on_twist(
+        self, twist: Sequence[float], frame: str, stamp: float, t: float
+    ) -> PipelineOutput:
+        """A twist from an outside source (keyboard, GUI) with header time `stamp`, received at `t` [s].
+
+        The pipeline's own twists, published for observers on a topic it also listens to, come back here:
+        they are recognised by stamp and values and dropped (they were handled when they were made).
+        """
+        out = self._check_clock(t)
+        if self._is_echo(twist, stamp):
+            return out
+        out.cycle = self.jog.on_twist(twist, frame, t, outside=True)
+        return out
+
+    def _is_echo(self, twist: Sequence[float], stamp: float) -> bool:
+        """Whether `twist` is one this pipeline sent: same values, stamped within 1 us of one it made."""
+        values = tuple(twist)
+        return any(abs(stamp - t) < 1e-6 and values == sent for t, sent in self._sent)
+
+    def on_twist_publishers(self, count: int) -> None:
+        """The number of publishers on the outside twist topic (a decrease can end an outside command)."""
+        self.jog.on_publishers(count)
+
+    # --- time ---
+    def next_due(self) -> float:
+        """When `tick` has work next [s]."""
+        return min(self.contact.next_due(), self.jog.next_due())
+
+    def tick(self, t: float) -> PipelineOutput:
+        """Every time-driven duty at `t`: the stale-wrench check (a zero twist, the move's end), then the jog
+        cycle due (a fixed-rate cycle, or a gap fill between twists)."""
+        out = self._check_clock(t)
+        if t >= self.contact.next_due():
+            self._to_jog(self.contact.tick(t), t, out)
+        cycle = self.jog.tick(t)
+        if cycle is not None:
+            out.cycle = cycle
+        return out
+
+    def prepare(self) -> None:
+        """Work for the next cycle, off the path from wrench to command: the contact force for the guard,
+        the jogger's Jacobian. Call after publishing."""
+        self.contact.update_contact()
+        self.jog.prepare()
+
+    def _check_clock(self, t: float) -> PipelineOutput:
+        """Resets the output; on a clock jump both stages stop (the zero twist is in `twist`)."""
+        out = self._out
+        out.twist = out.cycle = None
+        jump = self._clock.observe(t, self._monotonic())
+        if jump is not None:
+            note = jump.describe()
+            self.jog.clock_jumped(note)
+            self._sent.clear()
+            self._to_jog(self.contact.clock_jumped(note, t) or ZERO, t, out)
+        return out
+
+    # --- master ---
+    def master_lost(self, reason: str) -> PipelineOutput:
+        """The graph is broken: the move ends, the jogger stops and refuses commands until `master_back`."""
+        out = self._out
+        out.cycle = None
+        out.twist = self.contact.master_lost(reason)
+        self.jog.suspend(reason)
+        return out
+
+    def master_back(self) -> None:
+        self.contact.master_back()
+        self.jog.unsuspend()

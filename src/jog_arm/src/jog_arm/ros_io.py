@@ -1,0 +1,185 @@
+"""jog_arm's ROS surface around a `JogStage`: the joint command, `~status`, `~pause`/`~resume`/`~cycle_stats`.
+
+Used by jog_arm_server and by control_stack_node (which shares a process with contact_control). Also looks
+up, once, in tf the command frames the robot model lacks (cached as fixed relative to `planning_frame`).
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from typing import Any
+
+import pinocchio as pin
+import rospy
+import tf2_ros
+from compliant_control_msgs.msg import JogStatus
+from std_msgs.msg import Float64MultiArray
+from std_srvs.srv import Trigger, TriggerResponse
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+
+from jog_arm.settings import JogSettings, SettingsError
+from jog_arm.stage import JogCycle, JogStage, log_level
+
+__all__ = ["JogArmRos", "load"]
+
+_TF_ERRORS = (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException)
+WARN_PERIOD = 2.0  # [s] throttle of repeated warnings of one kind
+
+
+class JogArmRos:
+    """Publishers, services and tf of jog_arm; every stage call holds `lock`.
+
+    Args:
+        stage: The jog stage.
+        lock: The node's lock around the stage.
+        private_ns: Prefix of the private names: "~", or "/jog_arm_server/" in control_stack.
+    """
+
+    def __init__(self, stage: JogStage, lock: threading.Lock, private_ns: str = "~") -> None:
+        s = self._s = stage.settings
+        self._stage, self._lock = stage, lock
+        self._pub_lock = threading.Lock()  # the twist and timer threads share the command message
+        self._tf_buffer: tf2_ros.Buffer | None = None
+        self._tf_listener: tf2_ros.TransformListener | None = None
+        self._frames_ready: set[str] = set()
+        self._throttled: dict[str, float] = {}
+        self.closed = False
+        queue = None if s.publish_synchronously else 1  # None: no sender thread, see the README
+        self._cmd_msg: Any
+        if s.command_out_type == "trajectory":
+            self._cmd_msg = JointTrajectory(joint_names=stage.joint_names)
+            self._cmd_pub = rospy.Publisher(s.cmd_out_topic, JointTrajectory, queue_size=queue,
+                                            tcp_nodelay=True)
+        else:
+            self._cmd_msg = Float64MultiArray()
+            self._cmd_pub = rospy.Publisher(s.cmd_out_topic, Float64MultiArray, queue_size=queue,
+                                            tcp_nodelay=True)
+        self._status_msg = JogStatus()
+        self._status_pub = rospy.Publisher(private_ns + "status", JogStatus, queue_size=100)
+        self._services = [
+            rospy.Service(private_ns + "pause", Trigger, self._on_pause),
+            rospy.Service(private_ns + "resume", Trigger, self._on_resume),
+            rospy.Service(private_ns + "cycle_stats", Trigger, self._on_cycle_stats),
+        ]
+        rospy.loginfo(
+            "jog_arm_server: %d joints %s, tip %s, commands on %s (%s) -> %s on %s every %.4f s",
+            len(stage.joint_names), stage.joint_names, s.ee_frame_name, rospy.resolve_name(s.cmd_in_topic),
+            s.command_in_type, s.command_out_type, rospy.resolve_name(s.cmd_out_topic), s.pub_period,
+        )
+
+    # --- out ---
+    def publish(self, cycle: JogCycle | None) -> None:
+        """The cycle's joint command and status (status only while somebody listens); logs status changes
+        and the stage's notes. Called without the lock."""
+        if cycle is None or self.closed:
+            return
+        if cycle.publish:
+            self._publish_command(cycle)
+        if self._status_pub.get_num_connections() > 0:  # nobody listening: save the cycle the work
+            msg = self._status_msg
+            msg.header.stamp = rospy.Time.from_sec(cycle.t)
+            msg.code, msg.code_name, msg.message = int(cycle.status), cycle.status.name, cycle.message
+            msg.condition_number, msg.speed_scale = cycle.condition, cycle.scale
+            self._status_pub.publish(msg)
+        if cycle.status_changed:
+            cycle.status_changed = False
+            level = log_level(cycle.status)
+            log = rospy.logdebug if level == "debug" else rospy.loginfo if level == "info" else rospy.logwarn
+            log("jog_arm_server: %s: %s", cycle.status.name, cycle.message)
+
+    def _publish_command(self, cycle: JogCycle) -> None:
+        msg = self._cmd_msg
+        with self._pub_lock:
+            if isinstance(msg, Float64MultiArray):
+                msg.data = cycle.velocities
+            else:
+                # Stamp 0: "start now" for joint_trajectory_controller, whatever the transport delay.
+                duration = rospy.Duration.from_sec
+                msg.points = [
+                    JointTrajectoryPoint(positions=q, velocities=v, time_from_start=duration(t))
+                    for q, v, t in cycle.points
+                ]
+            self._cmd_pub.publish(msg)
+
+    def log_notes(self) -> None:
+        """Logs the stage's notes (lock held); "warn_throttle" ones at most once per WARN_PERIOD per kind."""
+        stage = self._stage
+        if not stage.notes:
+            return
+        now = time.monotonic()
+        for level, text in stage.notes:
+            if level == "warn_throttle":
+                kind = text.split(":", 1)[0]
+                if now < self._throttled.get(kind, 0.0):
+                    continue
+                self._throttled[kind] = now + WARN_PERIOD
+            rospy.logwarn("jog_arm_server: %s", text)
+        stage.notes.clear()
+
+    # --- frames ---
+    def ensure_frame(self, frame: str) -> None:
+        """Makes a frame tf knows but the model does not usable (looked up once, then cached). Without the
+        lock: the tf lookup may wait."""
+        frame = frame.lstrip("/") or self._s.default_cmd_frame
+        if frame in self._frames_ready:
+            return
+        with self._lock:
+            known = self._stage.knows_frame(frame)
+        if known:
+            self._frames_ready.add(frame)
+            return
+        if self._tf_buffer is None:
+            self._tf_buffer = tf2_ros.Buffer()
+            self._tf_listener = tf2_ros.TransformListener(self._tf_buffer)
+        try:
+            tf = self._tf_buffer.lookup_transform(self._s.planning_frame, frame, rospy.Time(0))
+        except _TF_ERRORS as err:  # not cached: tf may still be filling up; try again next command
+            rospy.logwarn_throttle(
+                WARN_PERIOD, f"jog_arm_server: frame {frame!r} is in neither the robot model nor tf: {err}"
+            )
+            return
+        q = tf.transform.rotation
+        rotation = pin.Quaternion(q.w, q.x, q.y, q.z).normalized().toRotationMatrix()
+        with self._lock:
+            self._stage.add_frame(frame, self._s.planning_frame, rotation)
+        self._frames_ready.add(frame)
+        rospy.loginfo("jog_arm_server: commands in %r use its tf rotation to %r, looked up once (assumed "
+                      "fixed)", frame, self._s.planning_frame)
+
+    # --- services ---
+    def _on_pause(self, _req: Any) -> TriggerResponse:
+        with self._lock:
+            return TriggerResponse(success=True, message=self._stage.pause())
+
+    def _on_resume(self, _req: Any) -> TriggerResponse:
+        with self._lock:
+            return TriggerResponse(success=True, message=self._stage.resume())
+
+    def _on_cycle_stats(self, _req: Any) -> TriggerResponse:
+        """Cycle timing since the previous call (or start), then starts a new window."""
+        with self._lock:
+            return TriggerResponse(success=True, message=self._stage.cycle_stats())
+
+    def master_lost(self, reason: str) -> None:
+        rospy.logerr("jog_arm_server: %s: stopping the arm until it returns", reason)
+
+    def shutdown(self) -> None:
+        """Stops publishing and unregisters the services and publishers."""
+        self.closed = True
+        for service in self._services:
+            service.shutdown()
+        self._cmd_pub.unregister()
+        self._status_pub.unregister()
+
+
+def load(params: dict[str, Any], urdf_xml: str | None, prefix: str) -> tuple[JogSettings, list[str]]:
+    """Validates the parameters and the presence of a robot description (no ROS calls).
+
+    Raises:
+        SettingsError: Naming the bad key, or the missing robot_description.
+    """
+    settings, warnings = JogSettings.from_params_with_warnings(params, prefix)
+    if not urdf_xml:
+        raise SettingsError("robot_description parameter is missing or empty: load the URDF first")
+    return settings, warnings

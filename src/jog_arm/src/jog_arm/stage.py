@@ -1,0 +1,290 @@
+"""JogStage: jog_arm without ROS: joint states and twists in, joint commands out, every timing rule here.
+
+`JogCalcs` does one cycle's arithmetic; this stage decides when cycles run and what surrounds them:
+- Cycles run every `pub_period` (`tick`), or, with `publish_on_command`, as soon as a twist arrives, with
+  `tick` filling gaps when twists stop (see `timing.FILL_AFTER`).
+- Twists from outside sources (keyboard, a GUI, `rostopic pub`) pass the contact guard; twists from a
+  controller in the same pipeline (contact_control) do not: they are the contact law's own answer.
+- A command whose publisher disconnects is dropped at once (the arm decelerates instead of running for
+  `incoming_cmd_timeout` more).
+- A clock jump drops the command and waits for a joint state received after it.
+No rospy here: the node (jog_arm_server, or control_stack's pipeline) reads the clock and the topics.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from jog_arm.contact_guard import ContactGuard
+from jog_arm.jog_calcs import JogCalcs, JogOutput
+from jog_arm.model_frames import ModelFrames
+from jog_arm.settings import JogSettings
+from jog_arm.status import StatusCode
+from jog_arm.timing import CycleMonitor, next_fill_time
+
+__all__ = ["ContactSource", "JogCycle", "JogStage", "log_level"]
+
+#: The latest contact force on the tool: ((fx, fy, fz) [N], its frame, the time it was measured [s]), or None.
+ContactSource = Callable[[], "tuple[Sequence[float], str, float] | None"]
+Point = tuple[tuple[float, ...], tuple[float, ...], float]  # positions, velocities, time_from_start [s]
+
+NOTE_SHOWN_FOR = 1.0  # [s] a clock jump stays in the status at least this long
+MISSED_WARNING_EVERY = 10.0  # [s] between warnings about missed cycles
+# While the contact guard cuts an outside twist, the status says so instead of these (why the arm stops).
+_GUARD_OUTRANKS = (StatusCode.NO_WARNING, StatusCode.JOINT_VELOCITY_SCALED, StatusCode.STALE_COMMAND)
+
+
+class JogCycle:
+    """What one cycle produced, for the node to publish. One instance per stage, refilled every cycle.
+
+    Attributes:
+        publish: Whether a joint command is due (`points` is valid).
+        points: The command's trajectory points (one, or `simu_points` extrapolated ones).
+        velocities: The command's joint velocities (for a velocity interface).
+        status, message, condition, scale: For the status message.
+        status_changed: The status code differs from the previous cycle's (worth a log line).
+        t: The cycle's time [s].
+    """
+
+    __slots__ = ("condition", "message", "points", "publish", "scale", "status", "status_changed", "t",
+                 "velocities")
+
+    def __init__(self) -> None:
+        self.publish = False
+        self.points: list[Point] = []
+        self.velocities: tuple[float, ...] = ()
+        self.status = StatusCode.NO_JOINT_STATE
+        self.message = ""
+        self.condition = math.nan
+        self.scale = 0.0
+        self.status_changed = False
+        self.t = 0.0
+
+
+class JogStage:
+    """One arm's jogging: see the module docstring. Not thread-safe: the node holds one lock around calls.
+
+    Args:
+        settings: Validated parameters.
+        urdf_xml: The robot description.
+        contact: Where the contact guard reads the force; None: from `on_contact_wrench` (a topic).
+        monotonic: The monotonic clock (for how long a fault stays in the status).
+
+    Raises:
+        KinematicsError, SettingsError: The configuration does not fit the robot model.
+    """
+
+    def __init__(
+        self,
+        settings: JogSettings,
+        urdf_xml: str,
+        contact: ContactSource | None = None,
+        monotonic: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self.settings = s = settings
+        self.jog = JogCalcs(settings, urdf_xml)
+        self.frames = ModelFrames(self.jog.model, lambda: self.jog.measured)
+        self.joint_names = list(self.jog.joint_names)
+        self._joint_set = frozenset(self.joint_names)
+        self._monotonic = monotonic
+        self._period = s.pub_period
+        self._points = s.simu_points if s.simu else 1
+        self._cycle = JogCycle()
+        self._last_status = StatusCode.NO_JOINT_STATE
+        self._cycles = CycleMonitor(s.pub_period)
+        self._next_missed_warning = -math.inf
+        self._last_twist_cycle = -math.inf  # publish_on_command: the last cycle a twist ran
+        self._last_fill = -math.inf  # publish_on_command: the last cycle tick ran
+        self._next_cycle = -math.inf  # timer mode: when the next cycle is due
+        self._from_topic = False  # the current command came from an outside source
+        self._publishers = 0
+        self._fault_note = ""
+        self._fault_shown_until = 0.0
+        self.notes: list[tuple[str, str]] = []  # (level, text) for the node's log, drained by it
+        self.guard: ContactGuard | None = None
+        if s.contact_guard_enabled:
+            self.guard = ContactGuard(s.contact_guard_max_force, s.contact_guard_slow_force,
+                                      s.contact_guard_slow_speed, s.contact_guard_timeout,
+                                      s.contact_guard_relief_speed)
+        self._contact: tuple[Sequence[float], str, float] | None = None
+        self._contact_source: ContactSource = contact or (lambda: self._contact)
+        self._guard_note = ""
+        self._guard_acted = False
+
+    # --- inputs ---
+    def on_joint_state(self, names: Sequence[str], positions: Sequence[float], t: float) -> bool:
+        """A JointState's names and positions received at `t` [s]. False if it is not usable (a controlled
+        joint missing or not finite); a warning is noted only if it names some of our joints (other robots'
+        and grippers' states are ignored silently)."""
+        ok = self.jog.set_joint_state_named(names, positions, t)
+        if not ok and self._joint_set.intersection(names):
+            self.notes.append(("warn_throttle", "ignoring a joint state that lacks finite positions for "
+                               f"{self.joint_names}"))
+        return ok
+
+    def on_contact_wrench(self, force: Sequence[float], frame: str, t: float) -> None:
+        """The contact force (from contact_control's `~contact_wrench` topic) for the guard."""
+        self._contact = (force, frame, t)
+
+    def on_twist(
+        self, twist: Sequence[float], frame: str, t: float, outside: bool = True
+    ) -> JogCycle | None:
+        """A velocity command (vx, vy, vz, wx, wy, wz) in `frame` ("": the default) received at `t` [s].
+
+        Args:
+            outside: From a topic (keyboard, GUI): it passes the contact guard and is dropped when its
+                publisher disconnects. False: from the controller in the same pipeline.
+
+        Returns:
+            The cycle it ran (publish_on_command), else None. A refused command is noted for the log and
+            makes the arm stop (see `JogCalcs.set_command`).
+        """
+        frame = frame.lstrip("/")
+        if outside and self.guard is not None:
+            twist = self._guarded(twist, frame or self.settings.default_cmd_frame, t)
+        result = self.jog.set_command(twist, frame, t)
+        self._from_topic = outside
+        if not result.accepted:
+            self.notes.append(("warn_throttle", f"command refused: {result.reason}"))
+            return None
+        if self.settings.publish_on_command:
+            self._last_twist_cycle = t
+            return self.cycle(t)
+        return None
+
+    def on_publishers(self, count: int) -> None:
+        """How many publishers the twist topic has now: one fewer while the command came from it means its
+        source died or was stopped, so the command is dropped (the arm stops at once)."""
+        if count < self._publishers and self._from_topic:
+            self.jog.drop_command("the command's publisher disconnected")
+            self._from_topic = False
+        self._publishers = count
+
+    def _guarded(self, twist: Sequence[float], frame: str, t: float) -> Sequence[float]:
+        """The twist the contact guard lets through (the force turned into the twist's frame)."""
+        assert self.guard is not None
+        contact = self._contact_source()
+        force: tuple[float, ...] | None = None
+        age = 0.0
+        if contact is not None:
+            raw, force_frame, measured = contact
+            age = t - measured
+            force = tuple(raw)
+            if force_frame and force_frame != frame:
+                try:
+                    pose = self.frames.pose(force_frame, frame)
+                except LookupError:
+                    pose = None
+                if pose is None:  # cannot say which way is into the contact: treat like no fresh force
+                    force, age = (math.nan,) * 3, 0.0
+                else:
+                    force = tuple(sum(pose[r][c] * raw[c] for c in range(3)) for r in range(3))
+        result = self.guard.limit(twist, force, age)
+        if result.message != self._guard_note and result.acted:
+            self.notes.append(("warn_throttle", result.message))
+        self._guard_note, self._guard_acted = result.message, result.acted
+        return result.twist
+
+    # --- time ---
+    def next_due(self) -> float:
+        """When `tick` has a cycle to run [s, the clock of `t`]."""
+        if self.settings.publish_on_command:
+            return next_fill_time(self._last_twist_cycle, self._last_fill, self._period)
+        return self._next_cycle
+
+    def tick(self, t: float) -> JogCycle | None:
+        """Runs the cycle due at `t`, if any: every pub_period, or with publish_on_command one to fill a
+        gap between twists (then one per period once they stop, to bring the arm to rest)."""
+        if t < self.next_due():
+            return None
+        if self.settings.publish_on_command:
+            self._last_fill = t
+        else:  # fixed rate; after a stall, restart the schedule instead of catching up with a burst
+            due = self._next_cycle + self._period
+            self._next_cycle = due if due > t else t + self._period
+        return self.cycle(t)
+
+    def clock_jumped(self, note: str) -> None:
+        """The clock jumped: stop until a fresh joint state and a new command; restart the schedules."""
+        self.notes.append(("warn", f"{note}: stopping until a fresh joint state and a new command"))
+        self._last_twist_cycle = self._last_fill = self._next_cycle = -math.inf
+        self._fault_note, self._fault_shown_until = note, self._monotonic() + NOTE_SHOWN_FOR
+        self.jog.clock_jumped(note)
+
+    # --- the cycle ---
+    def cycle(self, t: float) -> JogCycle:
+        """One control cycle at `t`: the joint command (if due) and the status."""
+        if self._cycles.tick(t) and t >= self._next_missed_warning:
+            self._next_missed_warning = t + MISSED_WARNING_EVERY
+            self.notes.append(("warn", f"{self._cycles.missed} publish cycles missed so far (longest gap "
+                               f"{self._cycles.max_gap * 1e3:.1f} ms, period {self._period * 1e3:g} ms)"))
+        out: JogOutput = self.jog.step(t)
+        c = self._cycle
+        c.t = t
+        c.publish = out.publish
+        if out.publish:
+            c.velocities = out.velocities
+            if self._points > 1:
+                c.points = self.jog.trajectory_points(self._points)
+            else:
+                c.points = [(out.positions, out.velocities, self._period)]
+        status, message = out.status, out.message
+        if self._guard_acted and self._from_topic and status in _GUARD_OUTRANKS:
+            status, message = StatusCode.CONTACT_GUARD, self._guard_note
+        if self._fault_note:
+            if self._monotonic() < self._fault_shown_until:
+                message = f"{self._fault_note}; {message}"
+            else:
+                self._fault_note = ""
+        c.status, c.message, c.condition, c.scale = status, message, out.condition_number, out.speed_scale
+        c.status_changed = status != self._last_status
+        self._last_status = status
+        return c
+
+    def prepare(self) -> None:
+        """The next cycle's twist-independent work (Jacobian, factorisation) now: call it after publishing,
+        off the path from twist to command."""
+        self.jog.prefetch()
+
+    # --- modes ---
+    def pause(self) -> str:
+        self.jog.pause()
+        return "paused: stopping, commands ignored until ~resume"
+
+    def resume(self) -> str:
+        was_paused = self.jog.paused
+        self.jog.resume()
+        return "resumed: waiting for a new command" if was_paused else "was not paused"
+
+    def suspend(self, reason: str) -> None:
+        """Stop, and refuse commands until `unsuspend` (e.g. the ROS master is lost)."""
+        self.jog.suspend(reason)
+
+    def unsuspend(self) -> None:
+        self.jog.unsuspend()
+
+    def cycle_stats(self) -> str:
+        """Cycle timing since the previous call (or start), then a new window."""
+        summary = self._cycles.summary()
+        self._cycles.reset()
+        return " ".join(f"{k}={v}" for k, v in summary.items())
+
+    # --- frames the model lacks ---
+    def knows_frame(self, frame: str) -> bool:
+        return self.jog.has_frame(frame)
+
+    def add_frame(self, frame: str, parent: str, rotation: Any) -> None:
+        """A frame the model lacks, fixed relative to the model frame `parent` (e.g. looked up in tf)."""
+        self.jog.add_frame(frame, parent, rotation)
+
+
+def log_level(status: StatusCode) -> str:
+    """How loudly a change to `status` is logged: "debug", "info" or "warn"."""
+    if status in (StatusCode.NO_WARNING, StatusCode.STALE_COMMAND, StatusCode.JOINT_VELOCITY_SCALED):
+        return "debug"
+    if status in (StatusCode.PAUSED, StatusCode.NO_JOINT_STATE, StatusCode.CONTACT_GUARD):
+        return "info"
+    return "warn"

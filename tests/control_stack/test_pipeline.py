@@ -1,0 +1,194 @@
+"""CompliantPipeline with no ROS master: the UR5 and Panda packages' own configuration and description, a
+perfect arm that executes each joint command, and generated wrenches (tool weight + a push)."""
+
+from __future__ import annotations
+
+import math
+import pathlib
+import subprocess
+import sys
+from collections.abc import Sequence
+
+import numpy as np
+import pytest
+import yaml
+from contact_control.axes import LAW_FOLLOWER
+from contact_control.laws import AxisLaw
+from contact_control.params import load_settings
+from control_stack.pipeline import CompliantPipeline, PipelineOutput
+from jog_arm.settings import JogSettings
+from jog_arm.status import StatusCode
+
+SRC = pathlib.Path(__file__).resolve().parents[2] / "src"
+DT = 0.002  # the robots' 500 Hz wrench and joint state
+DAMPING = 30.0  # [N/(m/s)] follower on Z: 4 N -> 0.133 m/s
+
+
+def _yaml(path: pathlib.Path) -> dict:
+    return yaml.safe_load(path.read_text()) or {}
+
+
+class Cell:
+    """One robot package's pipeline and a perfect arm (the commanded joint velocity happens exactly)."""
+
+    def __init__(self, robot: str) -> None:
+        pkg = SRC / f"{robot}_custom"
+        cc = load_settings({**_yaml(SRC / "contact_control/config/contact_control.yaml"),
+                            **_yaml(pkg / "config/contact_control.yaml")})
+        jog_params = {**_yaml(SRC / "jog_arm/config/jog_arm.yaml"), **_yaml(pkg / "config/jog_arm.yaml")}
+        jog, _ = JogSettings.from_params_with_warnings(jog_params, "/jog_arm_server/")
+        urdf = subprocess.run(
+            [sys.executable, str(SRC / "mujoco_driver/scripts/make_description"),
+             f"@{pkg / 'config/description.args'}"],
+            check=True, capture_output=True, text=True,
+        ).stdout
+        self.pipeline = CompliantPipeline(cc, jog, urdf)
+        start = _yaml(pkg / "config/named_poses.yaml")["poses"]["start"]
+        self.names = list(self.pipeline.jog.joint_names)
+        self.q = np.array([start[n] for n in self.names], dtype=float)
+        self.cc = cc
+        self.t = 0.0
+        self.commands: list[tuple[float, tuple[float, ...]]] = []
+
+    def pose(self, frame: str) -> np.ndarray:
+        return np.array(self.pipeline.jog.frames.pose(frame, self.cc.fixed_frame))
+
+    def wrench(self, push_fixed: Sequence[float]) -> tuple[float, ...]:
+        """What the sensor reads: the tool's weight and a force [N] given in the fixed frame."""
+        R = self.pose(self.cc.ft_sensor_frame)[:3, :3]
+        prep = self.pipeline.contact.ctrl.preprocessor
+        weight = prep.gravity_wrench(R.tolist())
+        force = R.T @ np.asarray(push_fixed, dtype=float)
+        oriented = [weight[i] + (force[i] if i < 3 else 0.0) for i in range(6)]
+        return tuple(prep.oriented(oriented))  # the sign flips are their own inverse
+
+    def _apply(self, out: PipelineOutput) -> None:
+        cycle = out.cycle
+        if cycle is not None and cycle.publish:
+            self.commands.append((self.t, cycle.velocities))
+            self.q = self.q + np.asarray(cycle.velocities) * DT
+
+    def step(self, push_fixed: Sequence[float] | None, nan: bool = False) -> PipelineOutput:
+        """One 2 ms period: the joint state, then the wrench (none if `push_fixed` is None), then tick."""
+        self.t += DT
+        p = self.pipeline
+        p.on_joint_state(self.names, self.q.tolist(), self.t)
+        out = None
+        if push_fixed is not None:
+            wrench = (math.nan,) * 6 if nan else self.wrench(push_fixed)
+            out = p.on_wrench(wrench, self.cc.ft_sensor_frame, self.t, self.t)
+            twist = out.twist
+            self._apply(out)
+            p.prepare()
+        if self.t >= p.next_due():
+            self._apply(p.tick(self.t))
+        if out is not None:
+            out.twist = twist
+        return out if out is not None else p.tick(self.t)
+
+    def follower_z(self) -> None:
+        laws = [AxisLaw() for _ in range(6)]
+        laws[2] = AxisLaw(LAW_FOLLOWER, damping=DAMPING)
+        self.pipeline.contact.ctrl.set_laws(laws, None, self.t)
+
+
+@pytest.fixture(scope="module", params=["ur5", "panda"])
+def robot(request: pytest.FixtureRequest) -> str:
+    return request.param
+
+
+@pytest.fixture
+def cell(robot: str) -> Cell:
+    c = Cell(robot)
+    for _ in range(50):  # the tool's weight only: tared on start-up
+        c.step((0.0, 0.0, 0.0))
+    return c
+
+
+def test_a_push_up_moves_the_tool_up_at_force_over_damping(cell: Cell) -> None:
+    cell.follower_z()
+    z0 = cell.pose("tool_tip")[:3, 3]
+    for _ in range(500):  # 1 s of a 4 N push up
+        cell.step((0.0, 0.0, 4.0))
+    moved = cell.pose("tool_tip")[:3, 3] - z0
+    # F/b = 0.133 m/s, reached after ~0.35 s of the 0.4 m/s^2 acceleration limit and the 5 Hz filter
+    assert 0.07 < moved[2] < 0.133, f"tool moved {moved} m"
+    assert abs(moved[0]) < 0.003 and abs(moved[1]) < 0.003, f"sideways drift {moved} m"
+
+
+def test_a_push_down_moves_it_down(cell: Cell) -> None:
+    cell.follower_z()
+    z0 = cell.pose("tool_tip")[2, 3]
+    for _ in range(250):
+        cell.step((0.0, 0.0, -4.0))
+    assert cell.pose("tool_tip")[2, 3] < z0 - 0.02
+
+
+def test_a_stale_wrench_brings_the_arm_to_rest_and_then_silence(cell: Cell) -> None:
+    cell.follower_z()
+    for _ in range(300):
+        cell.step((0.0, 0.0, 4.0))
+    assert max(map(abs, cell.commands[-1][1])) > 0.05, "the arm was not moving before the data stopped"
+    stop = cell.t
+    for _ in range(250):  # 0.5 s without wrenches: stale after wrench_timeout, then the halt sequence
+        cell.step(None)
+    moving = [t for t, v in cell.commands if t > stop and max(map(abs, v)) > 1e-9]
+    last_moving = max(moving, default=stop)
+    assert last_moving - stop < cell.cc.wrench_timeout + 0.15, f"still moving {last_moving - stop:.3f} s on"
+    assert cell.commands[-1][1] == (0.0,) * len(cell.names), "the last command is not a full stop"
+    assert cell.commands[-1][0] < cell.t - 0.1, "zero commands are still being sent: no silence after halt"
+    assert cell.pipeline.contact.status()[0].safety != 0
+
+
+def test_a_nan_wrench_yields_a_zero_twist_at_once(cell: Cell) -> None:
+    cell.follower_z()
+    for _ in range(300):
+        out = cell.step((0.0, 0.0, 4.0))
+    assert out.twist is not None and out.twist[2] > 0.05
+    out = cell.step((0.0, 0.0, 4.0), nan=True)
+    assert out.twist == (0.0,) * 6
+    before = abs(cell.commands[-2][1][1]) + abs(cell.commands[-2][1][2])
+    after = abs(cell.commands[-1][1][1]) + abs(cell.commands[-1][1][2])
+    assert after < before, "the joint command did not start to slow down"
+    assert cell.pipeline.contact.ctrl.move_active, "a NaN holds; it does not end the move"
+
+
+def test_an_outside_twist_moves_the_arm_and_its_echo_is_dropped(cell: Cell) -> None:
+    p = cell.pipeline
+    frame = cell.cc.fixed_frame
+    x0 = cell.pose("tool_tip")[0, 3]
+    for _ in range(200):
+        cell.t += DT
+        p.on_joint_state(cell.names, cell.q.tolist(), cell.t)
+        cell._apply(p.on_twist((0.05, 0.0, 0.0, 0.0, 0.0, 0.0), frame, cell.t, cell.t))
+    assert cell.pose("tool_tip")[0, 3] > x0 + 0.01
+    # A copy of the pipeline's own twist (same stamp and values) changes nothing.
+    cell.follower_z()
+    out = cell.step((0.0, 0.0, 4.0))
+    assert out.twist is not None
+    echo = p.on_twist(out.twist, frame, cell.t, cell.t + 0.0003)
+    assert echo.cycle is None
+
+
+def test_a_clock_jump_back_halts_until_a_fresh_joint_state(cell: Cell) -> None:
+    cell.follower_z()
+    for _ in range(300):
+        cell.step((0.0, 0.0, 4.0))
+    cell.t -= 5.0
+    out = cell.pipeline.on_joint_state(cell.names, cell.q.tolist(), cell.t)  # the first input after it
+    assert out.twist == (0.0,) * 6
+    assert out.cycle is not None and out.cycle.status == StatusCode.STALE_JOINT_STATE
+    assert "clock jumped back" in out.cycle.message
+    out = cell.step((0.0, 0.0, 4.0))
+    assert out.twist is not None and out.twist[2] < 0.005, "the move did not restart from rest"
+    for _ in range(300):  # data after the jump: the move goes on
+        out = cell.step((0.0, 0.0, 4.0))
+    assert out.twist is not None and out.twist[2] > 0.05
+
+
+@pytest.mark.parametrize("module", ["control_stack.pipeline", "contact_control.stage", "jog_arm.stage"])
+def test_the_core_imports_no_rospy(module: str) -> None:
+    code = f"import sys, {module}; bad = [m for m in sys.modules if m.split('.')[0] in ('rospy', 'tf2_ros')]; " \
+        "print(bad); sys.exit(1 if bad else 0)"
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert run.returncode == 0, f"{module} imports {run.stdout or run.stderr}"
