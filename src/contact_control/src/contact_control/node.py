@@ -201,9 +201,10 @@ class ContactControlNode:
         if cached is not None:
             return cached
         if self._model_has(frame):
-            return self._frame_source(frame, self._s.fixed_frame)  # type: ignore[misc]
+            return self._frame_source(frame, self._s.fixed_frame)  # type: ignore[misc, return-value]
         if self._buffer is None:  # a wrench in a frame no configured name mentioned
             self._listen_to_tf()
+            assert self._buffer is not None  # made by _listen_to_tf
         # The core call: Buffer.lookup_transform adds a can_transform round trip (~4 us) that only waits.
         msg = self._buffer.lookup_transform_core(self._s.fixed_frame, frame, self._time0)
         t, q = msg.transform.translation, msg.transform.rotation

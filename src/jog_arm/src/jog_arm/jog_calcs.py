@@ -217,7 +217,8 @@ class JogCalcs:
         self._twist = np.zeros(6)  # command, SI units, in its own frame
         self._twist_weighted = np.zeros(6)  # in root axes, linear part divided by singularity_length_scale
         self._frames: dict[str, _Frame] = {}
-        self._cmd_frame: _Frame | None = None
+        # None until set_command accepts a command; step() reads it only while following one.
+        self._cmd_frame: _Frame = None  # type: ignore[assignment]
         self._cmd_time: float | None = None
         self._cmd_zero = True
         self._rejected = ""
@@ -339,6 +340,7 @@ class JogCalcs:
         if reason:
             self._rejected = reason
             return CommandResult(False, reason)
+        assert resolved is not None  # no reason: the frame resolved
         self._rejected = ""
         # Plain floats: at this size numpy's per-call overhead dominates, more so with cold caches.
         lin, rot = self._unit_scales

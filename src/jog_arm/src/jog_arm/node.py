@@ -173,7 +173,7 @@ class JogArmNode:
     def accept_twist(self, msg: TwistStamped) -> None:
         """A velocity command from the topic (an outside source: it goes through the contact guard)."""
         lin, ang = msg.twist.linear, msg.twist.angular
-        twist = (lin.x, lin.y, lin.z, ang.x, ang.y, ang.z)
+        twist: Sequence[float] = (lin.x, lin.y, lin.z, ang.x, ang.y, ang.z)
         now = self._now()
         if self._guard is not None:
             twist = self._guarded(twist, msg.header.frame_id.lstrip("/") or self._s.default_cmd_frame, now)
