@@ -19,6 +19,7 @@ test: build
 
 lint: build
 	@$(ENV) ruff check src tests scripts
+	@$(ENV) mypy  # every package's library under src/ (mypy.ini)
 	@$(ENV) catkin_lint -W2 --strict --offline src 2>&1 | grep -v rosdep
 
 demo: build

@@ -456,6 +456,7 @@ class ContactControl:
             if code == SAFETY_NAN:
                 return self._hold(t, SAFETY_NAN, "wrench contains NaN or inf: holding until valid data")
             self._trip(w)
+        assert w is not None  # None only with SAFETY_NAN, returned above
         if self._latched:
             return self._hold(t, SAFETY_OVER_LIMIT, self._latch_message)
         self._wrench = w

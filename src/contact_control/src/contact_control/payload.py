@@ -72,7 +72,7 @@ def gravity_in_sensor(
 ) -> tuple[float, float, float]:
     """Gravity [m/s^2] in the sensor frame: R^T g."""
     r = np.asarray(R_world_sensor, dtype=float)
-    return tuple((r.T @ np.asarray(gravity, dtype=float)).tolist())  # type: ignore[return-value]
+    return tuple((r.T @ np.asarray(gravity, dtype=float)).tolist())
 
 
 def _skew(u: np.ndarray) -> np.ndarray:
@@ -120,7 +120,7 @@ def fit_payload(samples: Iterable[tuple[Sequence[float], Sequence[float]]]) -> P
     com = tuple((x_t[:3] / mass).tolist())
     return PayloadFit(
         mass=mass,
-        com=com,  # type: ignore[arg-type]
+        com=com,
         bias=tuple(x_f[1:].tolist()) + tuple(x_t[3:].tolist()),
         force_rms=float(math.sqrt(np.mean((A_f @ x_f - y_f) ** 2))),
         torque_rms=float(math.sqrt(np.mean((A_t @ x_t - y_t) ** 2))),

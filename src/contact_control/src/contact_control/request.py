@@ -246,6 +246,7 @@ def _axis_law(
     if law == LAW_FOLLOWER:
         return AxisLaw(LAW_FOLLOWER, damping=b, force_limit=limit, max_travel=travel, exceeded_action=action)
     if law == LAW_FORCE_TRACKING:
+        assert target is not None  # refused above
         return _tracking_law(axis, b, v, limit, travel, action, float(target), limits, fail)
     # compliant move
     if not (b >= 0.0 and math.isfinite(b)):
@@ -397,7 +398,9 @@ def validate_laws_request(req: Any, limits: RequestLimits | None = None) -> list
         for name in AXES:
             a = getattr(req, name)
             numbers = (a.damping, a.stiffness, a.velocity, a.force_limit, a.max_travel)
-            values = (int(a.law), *(float(x) for x in numbers))
+            kind = int(a.law)
+            damping, stiffness, velocity, force_limit, max_travel = (float(x) for x in numbers)
+            values = (kind, damping, stiffness, velocity, force_limit, max_travel)
             raw.append((values, int(a.exceeded_action), float(getattr(a, "target_force", 0.0))))
     except (AttributeError, TypeError, ValueError) as err:
         raise RequestError(FAILURE, f"malformed ConfigureLaws request: {err}") from err

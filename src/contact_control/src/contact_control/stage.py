@@ -39,7 +39,7 @@ __all__ = ["Answer", "ContactStage", "PoseSource", "Velocity", "describe_laws"]
 PoseSource = Callable[[str], "list[list[float]]"]
 Velocity = tuple[float, float, float, float, float, float]  # a twist in velocity_command_frame
 
-ZERO: Velocity = (0.0,) * 6  # type: ignore[assignment]
+ZERO: Velocity = (0.0,) * 6
 FAULT_SHOWN_FOR = 1.0  # [s] a clock jump stays on ~status at least this long, so a 50 Hz reader sees it
 
 

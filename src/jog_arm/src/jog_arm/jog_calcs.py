@@ -336,6 +336,7 @@ class JogCalcs:
         if reason:
             self._rejected = reason
             return CommandResult(False, reason)
+        assert resolved is not None  # no reason: the frame resolved
         self._rejected = ""
         # Plain floats: at this size numpy's per-call overhead dominates, more so with cold caches.
         lin, rot = self._unit_scales

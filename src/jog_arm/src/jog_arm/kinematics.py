@@ -146,7 +146,7 @@ class ArmModel:
         """Neutral (all zero) configuration of the controlled joints, one angle each, a fresh array."""
         return np.zeros(self.nv)
 
-    def pin_q(self, q: Sequence[float], out: np.ndarray | None = None) -> np.ndarray:
+    def pin_q(self, q: Sequence[float] | np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Pinocchio configuration for the joint values `q` (one per joint, model order).
 
         Args:

@@ -60,10 +60,10 @@ class JointLimiter:
 
     def __init__(
         self,
-        lower: Sequence[float],
-        upper: Sequence[float],
-        max_velocity: Sequence[float],
-        max_acceleration: Sequence[float],
+        lower: Sequence[float] | np.ndarray,
+        upper: Sequence[float] | np.ndarray,
+        max_velocity: Sequence[float] | np.ndarray,
+        max_acceleration: Sequence[float] | np.ndarray,
         margin: float,
         slowdown_width: float,
         period: float,

@@ -72,7 +72,7 @@ EXCEEDED_ACTIONS: dict[str, tuple[int, str]] = {
 
 # cartesian_impedance_msgs/CartesianForceCtrlErrorCodes, with what contact_control means by each.
 _SUCCESS = 1
-_RESPONSES: dict[int, tuple[str, str]] = {
+_RESPONSES: dict[int | None, tuple[str, str]] = {  # None (no code known): the default
     99999: (
         "FAILURE",
         "contact control cannot take laws now (a safety stop may be latched: press Reset) "
@@ -135,7 +135,8 @@ def preset_form(config: GuiConfig, name: str) -> Form:
     form = default_form()
     for axis, values in preset.axes.items():
         row = law_form(config, axis, values["law"])
-        form[axis] = replace(row, **{k: float(v) for k, v in values.items() if k != "law"})
+        numbers: dict[str, Any] = {k: float(v) for k, v in values.items() if k != "law"}
+        form[axis] = replace(row, **numbers)
     return form
 
 

@@ -226,16 +226,18 @@ def _remove_subtrees(robot: ET.Element, roots: Sequence[str]) -> None:
     while stack:
         name = stack.pop()
         doomed_links.add(name)
-        for joint, child in children.get(name, []):
+        for joint, child_link in children.get(name, []):
             doomed_joints.add(joint.get("name", ""))
-            stack.append(child)
+            stack.append(child_link)
     for joint in robot.findall("joint"):
         child = joint.find("child")
         if child is not None and child.get("link") in doomed_links:
             doomed_joints.add(joint.get("name", ""))
     for elem in list(robot):
-        name = elem.get("name")
-        if (elem.tag == "link" and name in doomed_links) or (elem.tag == "joint" and name in doomed_joints):
+        elem_name = elem.get("name")
+        if (elem.tag == "link" and elem_name in doomed_links) or (
+            elem.tag == "joint" and elem_name in doomed_joints
+        ):
             robot.remove(elem)
         elif elem.tag == "gazebo" and elem.get("reference") in doomed_links:
             robot.remove(elem)
@@ -345,7 +347,7 @@ def build_description(
         mesh.set("filename", resolve_package_uri(uri, erd_dir))
     if tool is not None:
         tool.validate()
-        links = {link.get("name") for link in robot.findall("link")}
+        links = {n for link in robot.findall("link") if (n := link.get("name")) is not None}
         if tool.parent not in links:
             raise DescriptionError(f"tool parent link {tool.parent!r} not in the URDF")
         clash = links & {tool.ft_name, tool.name, tool.tip_name}

@@ -82,6 +82,7 @@ class DriverEmulation:
     def refusal(self, controller: str) -> str:
         """Why a command to ``controller`` does not move the arm now ("" = it does)."""
         if self.reflex is not None and self.reflex.tripped:
+            assert self.profile.reflex is not None  # self.reflex is made from it
             return (f"the robot stopped in a reflex ({self.reflex.reason}): call "
                     f"{self.profile.reflex.recovery_action}")
         if not self.controllers.accepts(controller):

@@ -30,6 +30,7 @@ import tempfile
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -127,7 +128,7 @@ def convert_mesh(path: str, cache_dir: str) -> str:
         import trimesh  # optional: only URDFs with meshes MuJoCo cannot read need it
     except ImportError as exc:
         raise MeshError(f"trimesh is not installed ({exc})") from exc
-    key = hashlib.sha256(data + trimesh.__version__.encode()).hexdigest()[:16]
+    key = hashlib.sha256(data + str(trimesh.__version__).encode()).hexdigest()[:16]
     stem = os.path.splitext(os.path.basename(path))[0]
     target = os.path.join(cache_dir, f"{stem}-{key}.stl")
     if os.path.isfile(target):
@@ -151,7 +152,7 @@ def convert_mesh(path: str, cache_dir: str) -> str:
     fd, tmp = tempfile.mkstemp(suffix=".stl", dir=cache_dir)
     try:
         with os.fdopen(fd, "wb") as handle:
-            handle.write(mesh.export(file_type="stl"))
+            handle.write(cast(bytes, mesh.export(file_type="stl")))  # binary STL
         os.replace(tmp, target)
     except BaseException:
         if os.path.exists(tmp):
@@ -177,7 +178,7 @@ def _rotation(rpy: np.ndarray) -> np.ndarray:
     ])
 
 
-def _fmt(values: Sequence[float]) -> str:
+def _fmt(values: Sequence[float] | np.ndarray) -> str:
     return " ".join(repr(round(float(v), 9)) for v in values)
 
 
@@ -188,10 +189,12 @@ def _origin(elem: ET.Element) -> tuple[np.ndarray, np.ndarray]:
     return _floats(origin.get("xyz"), (0, 0, 0)), _floats(origin.get("rpy"), (0, 0, 0))
 
 
-def _collision(xyz: Sequence[float], rpy: Sequence[float], tag: str, **attrs: str) -> ET.Element:
+def _collision(
+    xyz: Sequence[float] | np.ndarray, rpy: Sequence[float] | np.ndarray, tag: str, **attrs: str
+) -> ET.Element:
     collision = ET.Element("collision")
     ET.SubElement(collision, "origin", xyz=_fmt(xyz), rpy=_fmt(rpy))
-    ET.SubElement(ET.SubElement(collision, "geometry"), tag, **attrs)
+    ET.SubElement(ET.SubElement(collision, "geometry"), tag, attrs)
     return collision
 
 
@@ -291,8 +294,9 @@ def prepare_collision(robot: ET.Element, cache_dir: str | None = None) -> list[L
                 for visual in visuals:
                     collision = ET.SubElement(link, "collision")
                     for part in ("origin", "geometry"):
-                        if visual.find(part) is not None:
-                            collision.append(copy.deepcopy(visual.find(part)))
+                        elem = visual.find(part)
+                        if elem is not None:
+                            collision.append(copy.deepcopy(elem))
             elif _mass(link) > 0.0:
                 capsules = _child_capsules(link, children)
                 link.extend(capsules)

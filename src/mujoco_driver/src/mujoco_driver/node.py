@@ -128,7 +128,7 @@ class MujocoDriverNode:
         if self._clock_pub is not None and getattr(simtime, "_clock_sub", None) is not None:
             simtime._clock_sub.unregister()  # see _publish_clock
             simtime._clock_sub = None
-        if self._emu is None:
+        if profile is None:  # no emulation (self._emu is None)
             self._subs = [
                 rospy.Subscriber(s.trajectory_command_topic, JointTrajectory, self._on_trajectory,
                                  queue_size=1, tcp_nodelay=True),
@@ -150,9 +150,11 @@ class MujocoDriverNode:
             rospy.Service("~push", PushEEF, self._on_push),
             rospy.Service("~reset", Trigger, self._on_reset),
         ]
-        self._tf_pub = self._scaling_pub = self._mode_pub = None
-        self._recovery = None
-        if self._emu is not None:
+        self._tf_pub: rospy.Publisher | None = None
+        self._scaling_pub: rospy.Publisher | None = None
+        self._mode_pub: rospy.Publisher | None = None
+        self._recovery: Any = None  # actionlib.SimpleActionServer with a reflex
+        if profile is not None:  # self._emu is not None
             self._setup_emulation(profile, publisher)
         self._viewer = self._open_viewer() if s.viewer else None
         self._warned: dict[str, int] = {}
@@ -179,7 +181,7 @@ class MujocoDriverNode:
         s, sim = self._s, self._sim
         pacer = Pacer(sim.dt, s.real_time_factor, s.max_lag)
         meter = RtfMeter(s.rtf_period)
-        countdown = 0
+        countdown: float = 0
         next_view = 0.0
         # joint_states trail the wrench by a fraction of the wall-clock publish period (0 when running as fast
         # as possible).
@@ -263,6 +265,7 @@ class MujocoDriverNode:
     def _publish_clock(self) -> None:
         self._set_stamp()
         self._clock_msg.clock = self._stamp
+        assert self._clock_pub is not None  # called only with a /clock publisher
         self._clock_pub.publish(self._clock_msg)
         # This node's own rospy clock: set directly instead of through its /clock subscription (dropped in
         # __init__), which would deserialise every message this loop publishes. A fresh Time, because rospy
@@ -336,6 +339,7 @@ class MujocoDriverNode:
             return None
 
     def _sync_viewer(self) -> None:
+        assert self._viewer is not None
         if not self._viewer.is_running():
             self._viewer = None  # the user closed the window; the simulation goes on
             return
@@ -433,6 +437,7 @@ class MujocoDriverNode:
         """The real driver's extra topics and services (see the README's *Driver emulation*)."""
         from controller_manager_msgs.srv import ListControllers, SwitchController
 
+        assert self._emu is not None
         self._tf_pub = publisher("/tf", TFMessage)
         self._tf_msg = TFMessage(transforms=[TransformStamped() for _ in profile.tf])
         for t, spec in zip(self._tf_msg.transforms, profile.tf, strict=True):
@@ -462,6 +467,7 @@ class MujocoDriverNode:
 
     def _publish_emulated_state(self) -> None:
         """tf and speed scaling with the joint state they belong to (same stamp)."""
+        assert self._emu is not None and self._tf_pub is not None  # both made by _setup_emulation
         for t, (pos, quat) in zip(self._tf_msg.transforms, self._emu.transforms, strict=True):
             t.header.stamp = self._state_stamp
             tr, rot = t.transform.translation, t.transform.rotation
@@ -473,11 +479,16 @@ class MujocoDriverNode:
             self._scaling_pub.publish(self._scaling_msg)
 
     def _on_reflex(self) -> None:
+        emu = self._emu  # a reflex tripped: emulation with a reflex, so the ~robot_mode publisher exists
+        assert emu is not None and emu.reflex is not None and emu.profile.reflex is not None
+        assert self._mode_pub is not None
         rospy.logerr("mujoco_driver: %s: the arm stopped; commands are ignored until %s is called",
-                     self._emu.reflex.reason, self._emu.profile.reflex.recovery_action)
+                     emu.reflex.reason, emu.profile.reflex.recovery_action)
         self._mode_pub.publish(String("reflex"))
 
     def _on_recovery(self, _goal: Any) -> None:
+        # The recovery action server exists only with an emulated reflex.
+        assert self._emu is not None and self._mode_pub is not None
         with self._lock:
             recovered = self._emu.recover()
         if recovered:
@@ -489,6 +500,7 @@ class MujocoDriverNode:
         from controller_manager_msgs.msg import ControllerState, HardwareInterfaceResources
         from controller_manager_msgs.srv import ListControllersResponse
 
+        assert self._emu is not None  # the controller_manager services exist only with emulation
         with self._lock:
             listing = self._emu.controllers.listing()
         states = []
@@ -502,6 +514,7 @@ class MujocoDriverNode:
     def _on_switch_controller(self, req: Any) -> Any:
         from controller_manager_msgs.srv import SwitchControllerResponse
 
+        assert self._emu is not None
         with self._lock:
             result = self._emu.switch(list(req.start_controllers), list(req.stop_controllers), req.strictness)
             running = self._emu.controllers.running()
@@ -514,6 +527,7 @@ class MujocoDriverNode:
         return SwitchControllerResponse(ok=result.ok)
 
     def _on_zero(self, _req: Any) -> TriggerResponse:
+        assert self._emu is not None  # the zero service exists only with emulation
         with self._lock:
             self._emu.zero()
         return TriggerResponse(success=True, message="the force/torque sensor reads zero now")
@@ -523,6 +537,7 @@ class MujocoDriverNode:
             self._clock_offset += self._sim.time
             self._sim.reset()
             if self._emu is not None and self._emu.recover():  # back at the start: no reflex either
+                assert self._mode_pub is not None  # there was a reflex to recover from
                 self._mode_pub.publish(String("move"))
             self._velocity_active = False
             self._read_state()

@@ -53,8 +53,8 @@ class TrajectoryPoint(NamedTuple):
         time_from_start: Time of the point after the trajectory's start [s].
     """
 
-    positions: Sequence[float]
-    velocities: Sequence[float] | None
+    positions: Sequence[float] | np.ndarray
+    velocities: Sequence[float] | np.ndarray | None
     time_from_start: float
 
 
@@ -225,7 +225,7 @@ class Simulation:
         }
 
     # --------------------------------------------------------------- commands
-    def _vector(self, values: Sequence[float], what: str) -> np.ndarray:
+    def _vector(self, values: Sequence[float] | np.ndarray, what: str) -> np.ndarray:
         try:
             array = np.asarray(values, dtype=float)
         except (TypeError, ValueError) as exc:
@@ -236,7 +236,7 @@ class Simulation:
             raise CommandError(f"{what}: values must be finite, got {array}")
         return array
 
-    def set_position_targets(self, q: Sequence[float]) -> None:
+    def set_position_targets(self, q: Sequence[float] | np.ndarray) -> None:
         """Hold joint positions ``q`` (clamped to the joint limits).
 
         Raises:
@@ -246,7 +246,7 @@ class Simulation:
         np.clip(q, self.scene.lower, self.scene.upper, out=self._goal)
         self._mode, self._traj = MODE_POSITION, None
 
-    def set_velocity_targets(self, qd: Sequence[float]) -> None:
+    def set_velocity_targets(self, qd: Sequence[float] | np.ndarray) -> None:
         """Move the joints at ``qd`` until told otherwise (scaled down uniformly to the velocity limits).
 
         Raises:
@@ -281,6 +281,7 @@ class Simulation:
         velocities = np.zeros_like(positions)
         if has_vel:
             for i, point in enumerate(points):
+                assert point[1] is not None  # has_vel
                 velocities[i] = self._vector(point[1], f"trajectory point {i} velocities")
         if times[0] > 0.0:
             times = np.concatenate(([0.0], times))

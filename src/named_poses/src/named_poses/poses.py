@@ -55,8 +55,9 @@ def urdf_joints(urdf_xml: str) -> dict[str, UrdfJoint]:
             return float(attrs.get(key, default))
 
         continuous = kind == "continuous"
-        out[joint.get("name")] = UrdfJoint(
-            name=joint.get("name"),
+        name = joint.get("name", "")  # required by the URDF format
+        out[name] = UrdfJoint(
+            name=name,
             continuous=continuous,
             lower=-math.inf if continuous else get("lower", 0.0),
             upper=math.inf if continuous else get("upper", 0.0),
@@ -147,7 +148,7 @@ class NamedPoses:
         acceleration = _per_joint(data.get("max_acceleration", 1.0), "max_acceleration", joints)
         return cls(joints, arrays, velocity, acceleration, tuple(urdf[j].continuous for j in joints))
 
-    def goal(self, name: str, current: Sequence[float]) -> np.ndarray:
+    def goal(self, name: str, current: Sequence[float] | np.ndarray) -> np.ndarray:
         """The pose's angles [rad], continuous joints moved to the equivalent nearest `current`.
 
         Raises:

@@ -48,10 +48,10 @@ def _scalar_profile(peak_speed: float, peak_accel: float) -> tuple[float, float,
 
 
 def plan_move(
-    start: Sequence[float],
-    goal: Sequence[float],
-    max_velocity: Sequence[float],
-    max_acceleration: Sequence[float],
+    start: Sequence[float] | np.ndarray,
+    goal: Sequence[float] | np.ndarray,
+    max_velocity: Sequence[float] | np.ndarray,
+    max_acceleration: Sequence[float] | np.ndarray,
     sample_period: float = 0.02,
 ) -> JointMove:
     """Plan the synchronised rest-to-rest move from `start` to `goal`.

@@ -115,7 +115,7 @@ class PathReport:
         contact: Bodies that touch on the way (self-collision or the table), empty if none or unchecked.
     """
 
-    offset: tuple[float, float, float]
+    offset: tuple[float, ...]  # (x, y, z)
     reachable: bool
     worst_condition: float
     min_margin: float
@@ -132,7 +132,7 @@ def tip_path(
     """
     start = arm.frame_pose(np.asarray(q0, dtype=float), arm.tip_frame).copy()
     q = np.array(q0, dtype=float)
-    path = []
+    path: list[np.ndarray] = []
     for k in range(1, steps + 1):
         goal = pin.SE3(start.rotation, start.translation + np.asarray(offset, dtype=float) * k / steps)
         solved = solve_ik(arm, goal, q, iterations=50)

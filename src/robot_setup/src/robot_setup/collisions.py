@@ -32,7 +32,7 @@ class CollisionChecker:
     """
 
     def __init__(
-        self, urdf_xml: str, joint_names: Sequence[str], inside: Sequence[float] | None = None
+        self, urdf_xml: str, joint_names: Sequence[str], inside: Sequence[float] | np.ndarray | None = None
     ) -> None:
         # Any configuration within the limits will do for building the scene (`inside`, default all zero).
         start = dict(zip(joint_names, inside, strict=True)) if inside is not None else 0.0
@@ -60,7 +60,7 @@ class CollisionChecker:
             hops += 1
         return hops
 
-    def contacts(self, q: Sequence[float]) -> list[str]:
+    def contacts(self, q: Sequence[float] | np.ndarray) -> list[str]:
         """'body_a / body_b' for each pair touching (within CLEARANCE) at joint angles `q`; empty: none."""
         m, d = self.model, self.data
         for adr, value in zip(self._adr, q, strict=True):

@@ -122,10 +122,13 @@ def _tree(urdf_xml: str) -> tuple[str, dict[str, list[tuple[str, str, ET.Element
     children: dict[str, list[tuple[str, str, ET.Element]]] = {}
     child_links = set()
     for joint in robot.findall("joint"):
-        parent, child = joint.find("parent").get("link"), joint.find("child").get("link")
-        children.setdefault(parent, []).append((child, joint.get("type"), joint))
+        parent_elem, child_elem = joint.find("parent"), joint.find("child")
+        if parent_elem is None or child_elem is None:
+            raise GeneratorError(f"URDF joint {joint.get('name')!r} lacks its <parent> or <child>")
+        parent, child = parent_elem.get("link", ""), child_elem.get("link", "")
+        children.setdefault(parent, []).append((child, joint.get("type", ""), joint))
         child_links.add(child)
-    roots = [link.get("name") for link in robot.findall("link") if link.get("name") not in child_links]
+    roots = [link.get("name", "") for link in robot.findall("link") if link.get("name") not in child_links]
     if len(roots) != 1:
         raise GeneratorError(f"the URDF must have one root link, found {roots}")
     return roots[0], children
@@ -158,7 +161,7 @@ def plan_robot(spec: RobotSpec, log=print) -> Plan:
         raise GeneratorError(f"TOOL_MASS={spec.tool_mass}: must be positive [kg]")
     source, stock = _source(spec.urdf)
     root, children = _tree(stock)
-    links = {lnk.get("name") for lnk in ET.fromstring(stock).findall("link")}
+    links = {lnk.get("name", "") for lnk in ET.fromstring(stock).findall("link")}
     if spec.tip not in links:
         raise GeneratorError(f"TIP={spec.tip!r} is not a link of {spec.urdf}; links: {sorted(links)}")
     base = spec.base or _default_base(root, children, stock)

@@ -8,6 +8,8 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from robot_setup.generate import Plan
 
 __all__ = ["TRAJECTORY_TOPIC", "render"]
@@ -15,7 +17,9 @@ __all__ = ["TRAJECTORY_TOPIC", "render"]
 TRAJECTORY_TOPIC = "arm_controller/command"  # the simulated driver's JointTrajectory input
 
 
-def _joints(values: Sequence[float], joints: Sequence[str], fmt: str = "{:.4f}", indent: int = 2) -> str:
+def _joints(
+    values: Sequence[float] | np.ndarray, joints: Sequence[str], fmt: str = "{:.4f}", indent: int = 2
+) -> str:
     pad = " " * indent
     return "\n".join(f"{pad}{j}: {fmt.format(v)}" for j, v in zip(joints, values, strict=True))
 
@@ -70,7 +74,7 @@ install(DIRECTORY config launch DESTINATION ${{CATKIN_PACKAGE_SHARE_DESTINATION}
         f"# Removed: the subtree below the flange (the tool replaces it).\n--remove-link {link}\n"
         for link in plan.removed
     )
-    com = plan.spec and (0.0, 0.0, 0.05)
+    com = (0.0, 0.0, 0.05)
     files["config/description.args"] = f"""# Arguments of mujoco_driver's make_description for the {name} (read with: make_description @description.args);
 # {generated}.
 --source {plan.source}

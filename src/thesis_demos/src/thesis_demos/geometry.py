@@ -203,7 +203,7 @@ def load_obstacle(scene_path: str) -> Obstacle | None:
         raise DemoConfigError(f"{scene_path}: obstacle.position and obstacle.size need 3 numbers each")
     if any(abs(a) > 1e-9 for a in rpy):
         raise DemoConfigError(f"{scene_path}: obstacle.rpy must be 0 for the demos (an axis-aligned box)")
-    return Obstacle(position, size)  # type: ignore[arg-type]
+    return Obstacle(position, size)
 
 
 def tool_radius(description_args: str) -> float:
