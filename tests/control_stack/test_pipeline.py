@@ -188,7 +188,8 @@ def test_a_clock_jump_back_halts_until_a_fresh_joint_state(cell: Cell) -> None:
 
 @pytest.mark.parametrize("module", ["control_stack.pipeline", "contact_control.stage", "jog_arm.stage"])
 def test_the_core_imports_no_rospy(module: str) -> None:
-    code = (f"import sys, {module}; bad = [m for m in sys.modules if m.split('.')[0] in ('rospy', 'tf2_ros')]; "
+    code = (f"import sys, {module}; "
+            "bad = [m for m in sys.modules if m.split('.')[0] in ('rospy', 'tf2_ros')]; "
             "print(bad); sys.exit(1 if bad else 0)")
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert run.returncode == 0, f"{module} imports {run.stdout or run.stderr}"
