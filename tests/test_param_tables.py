@@ -28,7 +28,7 @@ def _sources(readme: pathlib.Path) -> list[str]:
 
 
 @pytest.mark.parametrize("readme", READMES, ids=lambda p: p.parent.name)
-def test_readme_parameter_tables_match_the_declarations(readme):
+def test_readme_parameter_tables_match_the_declarations(readme: pathlib.Path) -> None:
     text = readme.read_text()
     fresh = render(text)
     if fresh != text:
@@ -38,12 +38,12 @@ def test_readme_parameter_tables_match_the_declarations(readme):
 
 
 @pytest.mark.parametrize(("package", "source"), sorted(EXPECTED.items()))
-def test_every_node_with_parameters_has_a_generated_table(package, source):
+def test_every_node_with_parameters_has_a_generated_table(package: str, source: str) -> None:
     assert source in _sources(SRC / package / "README.md"), f"{package}: no params marker for {source}"
     assert len(load_schema(source)) > 0
 
 
-def test_markers_are_paired_and_name_a_schema():
+def test_markers_are_paired_and_name_a_schema() -> None:
     for readme in READMES:
         text = readme.read_text()
         begins = len(re.findall(r"^<!-- params:begin ", text, re.M))

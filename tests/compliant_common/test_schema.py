@@ -7,6 +7,7 @@ import dataclasses
 import math
 import sys
 import types
+from typing import Any
 
 import pytest
 from compliant_common.schema import Param, Schema, SchemaError, param, schema_of
@@ -31,7 +32,7 @@ class Demo:
 SCHEMA = schema_of(Demo, extra=[Param("robot_description", "str", "", doc="read by the node")])
 
 
-def test_the_declaration_gives_the_defaults_in_declaration_order():
+def test_the_declaration_gives_the_defaults_in_declaration_order() -> None:
     assert SCHEMA.names[:3] == ("rate", "topic", "enabled")
     assert SCHEMA.names[-2:] == ("overrides", "robot_description")
     defaults = Demo()
@@ -43,7 +44,7 @@ def test_the_declaration_gives_the_defaults_in_declaration_order():
     assert len(SCHEMA) == 12 and "rate" in SCHEMA and "nope" not in SCHEMA
 
 
-def test_load_converts_what_is_given_and_leaves_the_rest_to_the_defaults():
+def test_load_converts_what_is_given_and_leaves_the_rest_to_the_defaults() -> None:
     given = {"rate": 20, "com": [0, 0, 1], "names": ["a", "b"], "flip": -1.0, "scale/linear": 1}
     values = SCHEMA.load(given)
     assert values == {
@@ -79,14 +80,16 @@ BAD = [
 
 
 @pytest.mark.parametrize(("params", "message"), BAD, ids=[m.split(":")[0] for _, m in BAD])
-def test_a_bad_value_is_refused_naming_the_key_and_what_is_allowed(params, message):
+def test_a_bad_value_is_refused_naming_the_key_and_what_is_allowed(
+    params: dict[str, Any], message: str
+) -> None:
     with pytest.raises(SchemaError) as err:
         SCHEMA.load(params)
     assert str(err.value) == message
     assert err.value.key == next(iter(params))
 
 
-def test_an_unknown_key_is_refused_with_the_closest_valid_one():
+def test_an_unknown_key_is_refused_with_the_closest_valid_one() -> None:
     with pytest.raises(SchemaError) as err:
         SCHEMA.load({"rate": 10.0, "rtae": 1.0}, prefix="~")
     assert err.value.key == "rtae"
@@ -99,13 +102,13 @@ def test_an_unknown_key_is_refused_with_the_closest_valid_one():
     assert SCHEMA.unknown(["rate", "b", "a"]) == ["a", "b"]
 
 
-def test_check_validates_values_already_in_settings_form():
+def test_check_validates_values_already_in_settings_form() -> None:
     SCHEMA.check(SCHEMA.values_of(Demo()))
     with pytest.raises(SchemaError, match="rate"):
         SCHEMA.check({"rate": -1.0})
 
 
-def test_a_bad_declaration_fails_at_import():
+def test_a_bad_declaration_fails_at_import() -> None:
     with pytest.raises(TypeError, match=r"default -1\.0 is invalid: must be > 0"):
         Param("x", "float", -1.0, gt=0.0)
     with pytest.raises(TypeError, match="unknown type"):
@@ -116,7 +119,7 @@ def test_a_bad_declaration_fails_at_import():
         Schema([Param("x", "int", 1), Param("x", "int", 2)])
 
 
-def test_the_table_has_one_row_per_key_with_default_unit_range_and_doc():
+def test_the_table_has_one_row_per_key_with_default_unit_range_and_doc() -> None:
     rows = SCHEMA.table(prefix="~").splitlines()
     assert rows[0] == "| parameter | default | unit | range | meaning |"
     assert len(rows) == 2 + len(SCHEMA)
@@ -133,7 +136,7 @@ def test_the_table_has_one_row_per_key_with_default_unit_range_and_doc():
     assert rows[12] == "| `~overrides` | {} | | | per joint |"
 
 
-def test_render_replaces_only_the_marked_tables(monkeypatch):
+def test_render_replaces_only_the_marked_tables(monkeypatch: pytest.MonkeyPatch) -> None:
     module = types.ModuleType("schema_demo")
     module.SCHEMA = SCHEMA  # type: ignore[attr-defined]
     monkeypatch.setitem(sys.modules, "schema_demo", module)

@@ -365,7 +365,7 @@ def param(
     if isinstance(default, list | dict | set):  # mutable: each settings object gets its own copy
         factory: Callable[[], Any] = functools.partial(copy.copy, default)
         return cast(_T, dataclasses.field(default_factory=factory, metadata=metadata))
-    return cast(_T, dataclasses.field(default=default, metadata=metadata))
+    return dataclasses.field(default=default, metadata=metadata)
 
 
 def schema_of(settings_class: type, extra: Iterable[Param] = ()) -> Schema:
