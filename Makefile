@@ -6,7 +6,7 @@ DRIVER ?=
 ENV := scripts/with_env
 PYTEST_ARGS ?=
 
-.PHONY: setup build test lint demo bench robot check-robot clean
+.PHONY: setup build test lint demo bench robot check-robot param-tables clean
 
 setup:
 	@scripts/bootstrap setup
@@ -21,6 +21,10 @@ lint: build
 	@$(ENV) ruff check src tests scripts
 	@$(ENV) mypy  # every package's library under src/ (mypy.ini)
 	@$(ENV) catkin_lint -W2 --strict --offline src 2>&1 | grep -v rosdep
+
+# The parameter tables of the package READMEs, regenerated from the parameter declarations.
+param-tables: build
+	@$(ENV) python -m compliant_common.schema_docs --write
 
 demo: build
 	@$(ENV) python scripts/demo --robot $(ROBOT) $(if $(DRIVER),--driver $(DRIVER))

@@ -236,7 +236,8 @@ def test_readme_keys_table_matches_the_key_map():
 
 def test_readme_documents_every_parameter_with_its_default():
     text = README.read_text()
-    for name, (default, unit, _) in PARAMETERS.items():
+    for name, declared in PARAMETERS.items():
+        default, unit = declared.default, declared.unit
         row = next((line for line in text.splitlines() if line.startswith(f"| `~{name}` |")), None)
         assert row is not None, name
         cells = [cell.strip() for cell in row.split("|")]

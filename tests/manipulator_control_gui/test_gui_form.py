@@ -399,3 +399,20 @@ def test_an_exceeded_action_contact_control_would_refuse_is_caught_before_sendin
         assert err.value.code == -4 and "damping" in err.value.message
     with pytest.raises(FormError, match="Unknown action"):
         build_laws_request(CONFIG, form, action="explode")
+
+
+def test_panel_parameters_are_declared_once_and_unknown_keys_refused():
+    from manipulator_control_gui.params import load_settings
+    from manipulator_control_gui.ros_client import RosNames
+
+    assert RosNames.from_settings(load_settings({})) == RosNames()
+    names = RosNames.from_settings(
+        load_settings({"contact_control_node": "/robot/cc/", "configure_service": "/robot/configure"})
+    )
+    assert (names.tare_service, names.status_topic) == ("/robot/cc/tare", "/robot/cc/status")
+    assert names.laws_service == "/robot/configure_laws"
+    assert RosNames.from_settings(load_settings({"stop_service": "/halt"})).stop_service == "/halt"
+    with pytest.raises(ValueError, match=r"^~retry_perod is not a parameter: did you mean ~retry_period\?$"):
+        load_settings({"retry_perod": 2.0})
+    with pytest.raises(ValueError, match=r"^~retry_period: must be > 0, got 0$"):
+        load_settings({"retry_period": 0})

@@ -201,8 +201,14 @@ def test_bad_parameters_are_refused_naming_the_key(params, key):
         DriverSettings.from_params(params)
 
 
-def test_unknown_keys_are_reported():
-    assert DriverSettings.unknown_keys({"scene_config": "x", "rtf": 1, "viewer": False}) == ["rtf"]
+def test_unknown_keys_refuse_start_up_naming_the_closest_valid_key():
+    with pytest.raises(ParamError, match=r"^~rtf_perod is not a parameter: did you mean ~rtf_period\?$"):
+        DriverSettings.from_params({"scene_config": "x", "rtf_perod": 1.0, "viewer": False})
+    with pytest.raises(ParamError, match="~rtf is not a parameter"):
+        DriverSettings.from_params({"scene_config": "x", "rtf": 1})
+    # The node reads ~robot_description itself (emulated_robot.launch sets it).
+    settings = DriverSettings.from_params({"scene_config": "x", "robot_description": "<robot/>"})
+    assert settings.scene_config == "x"
 
 
 def test_urdf_root_link():

@@ -85,3 +85,28 @@ def test_every_robot_package_names_its_scene_start_pose_start(package):
     scene = yaml.safe_load((package / "config" / "sim.yaml").read_text())
     assert named["poses"]["start"] == pytest.approx(scene["start_pose"])
     assert "home" in named["poses"]
+
+
+def test_node_parameters_refuse_unknown_keys_and_bad_values_naming_the_key():
+    from named_poses.params import PARAMETERS, load_settings
+
+    settings = load_settings({"config": "/x/poses.yaml", "trajectory_topic": "t", "goal_tolerance": 0.02})
+    assert (settings.config, settings.trajectory_topic) == ("/x/poses.yaml", "t")
+    assert settings.goal_tolerance == 0.02
+    assert settings.settle_time == PARAMETERS["settle_time"].default == 3.0
+    typo = r"^~goal_tolerence is not a parameter: did you mean ~goal_tolerance\?$"
+    with pytest.raises(ValueError, match=typo):
+        load_settings({"goal_tolerence": 0.1})
+    with pytest.raises(ValueError, match=r"^~goal_tolerance: must be > 0, got 0$"):
+        load_settings({"goal_tolerance": 0})
+    with pytest.raises(ValueError, match="~trajectory_topic: must not be empty"):
+        load_settings({"trajectory_topic": ""})
+
+
+def test_file_limits_default_to_the_declared_parameters():
+    from named_poses.params import PARAMETERS
+
+    urdf = {"j": UrdfJoint("j", False, -1.0, 1.0, math.inf)}
+    poses = NamedPoses.from_dict({"poses": {"a": {"j": 0.0}}}, urdf)
+    assert poses.max_velocity[0] == PARAMETERS["max_velocity"].default
+    assert poses.max_acceleration[0] == PARAMETERS["max_acceleration"].default

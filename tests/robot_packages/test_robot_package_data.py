@@ -147,6 +147,44 @@ def test_hardware_stack_uses_the_vendor_drivers_topics(robot, joints, wrench, co
     assert jog["simu"] is False and "/mujoco_driver/scene_config" not in params
 
 
+def _load_private_parameters(node: str, values: dict) -> None:
+    """What the node does with its private parameters at start-up (unknown keys and bad values refused)."""
+    from contact_control.params import load_settings as contact_control_settings
+    from jog_arm.settings import JogSettings
+    from keyboard_publisher.teleop import TeleopSettings
+    from mujoco_driver.params import DriverSettings
+    from named_poses.params import load_settings as named_pose_settings
+
+    loaders = {
+        "/mujoco_driver": DriverSettings.from_params,
+        "/contact_control_node": contact_control_settings,
+        "/jog_arm_server": JogSettings.from_params,
+        "/named_poses": named_pose_settings,
+        "/key_to_twist": TeleopSettings.from_params,
+    }
+    loaders[node](values)
+
+
+@pytest.mark.parametrize("robot", ALL_ROBOTS)
+@pytest.mark.parametrize("launch_file", sorted(LAUNCH_FILES))
+def test_every_node_accepts_the_parameters_the_launch_file_gives_it(robot, launch_file):
+    """Unknown private parameters refuse start-up: none of the robot launch files may set one."""
+    params = dump_params(robot, launch_file)
+    nodes = {"/mujoco_driver", "/contact_control_node", "/jog_arm_server", "/named_poses", "/key_to_twist"}
+    given = {node: private(params, node) for node in nodes}
+    for node, values in given.items():
+        if values:
+            _load_private_parameters(node, values)
+    assert given["/contact_control_node"] and given["/jog_arm_server"] and given["/named_poses"]
+
+
+@pytest.mark.parametrize("robot", ALL_ROBOTS)
+def test_the_emulated_driver_accepts_its_launch_parameters(robot):
+    params = dump_params("mujoco_driver", "emulated_robot.launch", f"robot_package:={robot}",
+                         "profile:=ur_robot_driver")
+    _load_private_parameters("/mujoco_driver", private(params, "/mujoco_driver"))
+
+
 @pytest.mark.parametrize("robot", ROBOTS)
 @pytest.mark.parametrize("launch_file", ["sim.launch", "hardware.launch"])
 def test_description_loads_in_pinocchio_with_every_frame_the_configs_name(robot, launch_file):

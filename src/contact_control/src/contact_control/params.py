@@ -1,18 +1,18 @@
 """Typed settings of contact control, loaded once from the YAML / parameter-server dict and validated.
 
-Every key of the original `contact_control_conf.yaml` is accepted (see the package README); the additions
-carry units in their names or in `PARAMETERS` below, which is also the table the README documents. Errors
-name the key.
+Every key of the original `contact_control_conf.yaml` is accepted (see the package README). Each parameter
+is declared once, as a field of `ContactControlSettings` (name, type, default, unit, range, doc); `PARAMETERS`
+is that declaration as a schema, which validates the input and generates the README's table. Errors name
+the key.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass
 from typing import Any
 
-from compliant_common.keys import unknown_key_message
+from compliant_common.schema import SchemaError, param, schema_of
 
 __all__ = ["PARAMETERS", "AxisTuning", "ContactControlSettings", "ParamError", "load_settings"]
 
@@ -25,205 +25,190 @@ class ParamError(ValueError):
         self.key = key
 
 
-# key: (kind, default, unit, description). kind: str, bool, float, pos (> 0), nonneg (>= 0), sign (+1/-1),
-# vec3, vec6, optpos (> 0 or None).
-PARAMETERS: dict[str, tuple[str, Any, str, str]] = {
-    # topics and frames
-    "ft_in_topic": ("str", "wrench", "", "geometry_msgs/WrenchStamped input"),
-    "velocity_out_topic": ("str", "/ee_velocity", "", "geometry_msgs/TwistStamped output"),
-    "move_group": ("str", "", "", "name of the kinematic chain (informational; no MoveIt here)"),
-    "fixed_frame": ("str", "base_link", "", "world-fixed frame; gravity and travel are measured in it"),
-    "velocity_command_frame": ("str", "base_link", "", "frame of the published twist"),
-    "ft_sensor_frame": ("str", "base_link", "", "frame of the wrench (used when the header frame is empty)"),
-    "use_ft_sensor_frame": (
-        "bool", False, "", "ignore header.frame_id, take ft_sensor_frame (a recording in a frame tf lacks)",
-    ),
-    "control_frame": ("str", "base_link", "", "frame whose axes X..RZ the laws act along"),
-    "eef_frame": ("str", "tool0", "", "end-effector frame whose travel is measured"),
-    # timing
-    "control_rate": ("pos", 500.0, "Hz", "stale-check and hold timer rate; nominal cycle for rate limits"),
-    "status_rate": ("pos", 50.0, "Hz", "~status publish rate"),
-    "wrench_timeout": ("pos", 0.1, "s", "no wrench for longer: output zero (SAFETY_STALE)"),
-    "wrench_timeout_periods": (
-        "nonneg", 10.0, "", "the stale timeout is at least this many measured sample periods (0: fixed)",
-    ),
-    "no_data_end_timeout": ("nonneg", 1.0, "s", "stale for longer: the move ends with NO_FT_DATA"),
-    "check_stamp_age": ("bool", True, "", "wrenches stamped more than wrench_timeout ago are stale"),
-    "future_stamp_tolerance": (
-        "nonneg", 0.1, "s", "with check_stamp_age: wrenches stamped further ahead are refused like NaN",
-    ),
-    "publish_when_idle": ("bool", False, "", "publish zero twists when no move is active"),
-    "idle_zero_count": ("nonneg", 10.0, "", "zero twists sent after a move ends, then silence"),
-    "publish_synchronously": ("bool", True, "", "send the twist from the wrench callback, no sender thread"),
-    # wrench preprocessing
-    "lp_filter_enabled": ("bool", True, "", "second-order Butterworth low-pass on the wrench"),
-    "lp_filter_delta_t": ("pos", 0.002, "s", "expected sample period: the design until the rate is measured"),
-    "lp_filter_cutoff_freq": ("pos", 5.0, "Hz", "cutoff (true at the measured rate: lp_filter_rate_adapt)"),
-    "lp_filter_rate_adapt": (
-        "bool", True, "", "design the filter for the measured sample period (lp_filter_delta_t until known)",
-    ),
-    "ft_x_direction": ("sign", 1, "", "legacy sign flip of sensor force X and torque X (prefer tf frames)"),
-    "ft_y_direction": ("sign", 1, "", "legacy sign flip of sensor force Y and torque Y"),
-    "ft_z_direction": ("sign", 1, "", "legacy sign flip of sensor force Z and torque Z"),
-    "travel_x_direction": ("sign", 1, "", "legacy sign flip of the measured travel along X and about X"),
-    "travel_y_direction": ("sign", 1, "", "legacy sign flip of the measured travel along Y and about Y"),
-    "travel_z_direction": ("sign", 1, "", "legacy sign flip of the measured travel along Z and about Z"),
-    "tare_on_startup": ("bool", True, "", "tare with the first valid wrench"),
-    "bias": ("vec6", [0.0] * 6, "N, Nm", "sensor offset subtracted before the first tare (sensor frame)"),
-    "tool_mass": ("nonneg", 0.0, "kg", "payload below the sensor, gravity-compensated"),
-    "tool_com": ("vec3", [0.0, 0.0, 0.0], "m", "payload centre of mass in the sensor frame"),
-    "gravity": ("vec3", [0.0, 0.0, -9.81], "m/s^2", "gravity in fixed_frame"),
-    "force_deadband": ("nonneg", 0.0, "N", "wrench components below this read as zero (control frame)"),
-    "torque_deadband": ("nonneg", 0.0, "Nm", "same for torques"),
-    # global limits
-    "global_max_force": ("pos", 25.0, "N", "|force| above this: zero output, latched until ~reset"),
-    "global_max_torque": ("pos", 25.0, "Nm", "|torque| above this: same"),
-    "max_velocity": ("pos", 0.25, "m/s", "clamp of every linear velocity; compliant move speed range"),
-    "max_angular_velocity": ("optpos", None, "rad/s", "clamp of angular velocities (default: max_velocity)"),
-    # law tuning (the thesis fork's hard-coded numbers, named)
-    "follower_deadband_force": ("nonneg", 2.5, "N", "follower ignores smaller forces (decelerates)"),
-    "follower_deadband_torque": ("nonneg", 2.5, "Nm", "same for torques"),
-    "min_velocity_linear": ("nonneg", 0.005, "m/s", "commands of at most this magnitude become zero"),
-    "min_velocity_angular": ("nonneg", 0.005, "rad/s", "same for rotations"),
-    "acceleration_linear": ("pos", 2.5, "m/s^2", "limit on speeding up"),
-    "acceleration_angular": ("pos", 2.5, "rad/s^2", "same for rotations"),
-    "deceleration_linear": ("pos", 2.5, "m/s^2", "limit on slowing down (fork: 0.005 m/s per 2 ms cycle)"),
-    "deceleration_angular": ("pos", 2.5, "rad/s^2", "same for rotations"),
-    "spring_output_scale": ("pos", 0.2, "", "spring velocity factor (fork: 0.2)"),
-    "spring_rounding": ("nonneg", 0.01, "N, m/s", "spring rounds force and velocity to this step (0: off)"),
-    "compliant_slowdown_distance": ("nonneg", 0.02, "m", "compliant move slows down this near max travel"),
-    "compliant_slowdown_angle": ("nonneg", 0.02, "rad", "same for rotations"),
-    "compliant_approach_speed_linear": ("pos", 0.02, "m/s", "slowest compliant move speed when slowing"),
-    "compliant_approach_speed_angular": ("pos", 0.02, "rad/s", "same for rotations"),
-    "compliant_default_velocity_linear": (
-        "pos", 0.01, "m/s",
-        "V_desired of a compliant move requested without one, toward its force limit's sign",
-    ),
-    "compliant_default_velocity_angular": ("pos", 0.05, "rad/s", "same for rotations"),
-    # exceeded_action move_away (after a move ended on a force/torque limit)
-    "move_away_velocity_linear": ("pos", 0.01, "m/s", "speed of backing off along the contact force"),
-    "move_away_velocity_angular": ("pos", 0.05, "rad/s", "same for rotations"),
-    "move_away_release_fraction": (
-        "pos", 0.5, "",
-        "backing off ends once |F| is below this fraction of the axis's force/torque limit (hysteresis)",
-    ),
-    "move_away_max_distance": ("pos", 0.02, "m", "backing off ends after this distance at the latest"),
-    "move_away_max_angle": ("pos", 0.2, "rad", "same for rotations"),
-    # force tracking law (ConfigureLaws FORCE_TRACKING)
-    "force_tracking_deadband_force": (
-        "nonneg", 0.2, "N",
-        "force tracking holds still while |F - target| is at most this (no deadband around zero force)",
-    ),
-    "force_tracking_deadband_torque": ("nonneg", 0.02, "Nm", "same for torques"),
-    "force_tracking_contact_fraction": (
-        "pos", 0.5, "",
-        "force tracking approaches at its approach speed until F reaches this fraction of the target",
-    ),
-    "diff_max_force": ("nonneg", 0.0, "N", "force change within diff_window that ends a move (0: off)"),
-    "diff_max_torque": ("nonneg", 0.0, "Nm", "same for torques"),
-    "diff_window": ("pos", 0.1, "s", "time window of the force-jump check"),
-    "force_limit_arm_time": (
-        "nonneg", 0.5, "s",
-        "an axis's force limit is checked once it has reached its law's velocity, or after this (0: at once)",
-    ),
-}
+def _pos(default: float, unit: str, doc: str) -> Any:
+    return param(default, unit=unit, gt=0.0, doc=doc)
 
 
-@dataclass(frozen=True)
-class AxisTuning:
-    """Law tuning for one kind of axis (linear: N, m, m/s; angular: Nm, rad, rad/s)."""
+def _nonneg(default: float, unit: str, doc: str) -> Any:
+    return param(default, unit=unit, ge=0.0, doc=doc)
 
-    deadband: float = 2.5
-    min_velocity: float = 0.005
-    acceleration: float = 2.5
-    deceleration: float = 2.5
-    max_velocity: float = 0.25
-    slowdown: float = 0.02
-    approach_speed: float = 0.02
-    diff_max: float = 0.0
-    spring_scale: float = 0.2
-    spring_rounding: float = 0.01
-    default_velocity: float = 0.01
-    away_velocity: float = 0.01
-    away_max_travel: float = 0.02
-    track_deadband: float = 0.2
-    contact_fraction: float = 0.5
+
+def _sign(doc: str) -> Any:
+    return param(1, type="sign", doc=doc)
 
 
 @dataclass(frozen=True)
 class ContactControlSettings:
-    """All settings; field names are the parameter keys (see `PARAMETERS` for units)."""
+    """All settings; field names are the parameter keys, each declared once here (unit, range, doc)."""
 
-    ft_in_topic: str = "wrench"
-    velocity_out_topic: str = "/ee_velocity"
-    move_group: str = ""
-    fixed_frame: str = "base_link"
-    velocity_command_frame: str = "base_link"
-    ft_sensor_frame: str = "base_link"
-    use_ft_sensor_frame: bool = False
-    control_frame: str = "base_link"
-    eef_frame: str = "tool0"
-    control_rate: float = 500.0
-    status_rate: float = 50.0
-    wrench_timeout: float = 0.1
-    wrench_timeout_periods: float = 10.0
-    no_data_end_timeout: float = 1.0
-    check_stamp_age: bool = True
-    future_stamp_tolerance: float = 0.1
-    publish_when_idle: bool = False
-    idle_zero_count: float = 10.0
-    publish_synchronously: bool = True
-    lp_filter_enabled: bool = True
-    lp_filter_delta_t: float = 0.002
-    lp_filter_cutoff_freq: float = 5.0
-    lp_filter_rate_adapt: bool = True
-    ft_x_direction: int = 1
-    ft_y_direction: int = 1
-    ft_z_direction: int = 1
-    travel_x_direction: int = 1
-    travel_y_direction: int = 1
-    travel_z_direction: int = 1
-    tare_on_startup: bool = True
-    bias: tuple[float, ...] = (0.0,) * 6
-    tool_mass: float = 0.0
-    tool_com: tuple[float, ...] = (0.0, 0.0, 0.0)
-    gravity: tuple[float, ...] = (0.0, 0.0, -9.81)
-    force_deadband: float = 0.0
-    torque_deadband: float = 0.0
-    global_max_force: float = 25.0
-    global_max_torque: float = 25.0
-    max_velocity: float = 0.25
-    max_angular_velocity: float | None = None
-    follower_deadband_force: float = 2.5
-    follower_deadband_torque: float = 2.5
-    min_velocity_linear: float = 0.005
-    min_velocity_angular: float = 0.005
-    acceleration_linear: float = 2.5
-    acceleration_angular: float = 2.5
-    deceleration_linear: float = 2.5
-    deceleration_angular: float = 2.5
-    spring_output_scale: float = 0.2
-    spring_rounding: float = 0.01
-    compliant_slowdown_distance: float = 0.02
-    compliant_slowdown_angle: float = 0.02
-    compliant_approach_speed_linear: float = 0.02
-    compliant_approach_speed_angular: float = 0.02
-    compliant_default_velocity_linear: float = 0.01
-    compliant_default_velocity_angular: float = 0.05
-    move_away_velocity_linear: float = 0.01
-    move_away_velocity_angular: float = 0.05
-    move_away_release_fraction: float = 0.5
-    move_away_max_distance: float = 0.02
-    move_away_max_angle: float = 0.2
-    force_tracking_deadband_force: float = 0.2
-    force_tracking_deadband_torque: float = 0.02
-    force_tracking_contact_fraction: float = 0.5
-    diff_max_force: float = 0.0
-    diff_max_torque: float = 0.0
-    diff_window: float = 0.1
-    force_limit_arm_time: float = 0.5
-    #: Keys of the input that are not parameters (the node warns about them).
-    unknown_keys: tuple[str, ...] = field(default=(), compare=False)
+    # topics and frames
+    ft_in_topic: str = param("wrench", doc="geometry_msgs/WrenchStamped input (original name)")
+    velocity_out_topic: str = param("/ee_velocity", doc="geometry_msgs/TwistStamped output (original name)")
+    move_group: str = param("", doc="original: MoveIt group; informational here, the EEF is `eef_frame`")
+    fixed_frame: str = param(
+        "base_link", doc="world-fixed frame with z up; gravity and travel are measured in it"
+    )
+    velocity_command_frame: str = param("base_link", doc="frame of the published twist")
+    ft_sensor_frame: str = param(
+        "base_link", doc="frame of the wrench when its `header.frame_id` is empty (or `use_ft_sensor_frame`)"
+    )
+    use_ft_sensor_frame: bool = param(
+        False,
+        doc="ignore the wrench's `header.frame_id` and take `ft_sensor_frame` (a recording whose frame tf "
+        "lacks)",
+    )
+    control_frame: str = param("base_link", doc="frame whose axes X..RZ the laws act along")
+    eef_frame: str = param("tool0", doc="end effector whose travel is measured (new)")
+    # timing
+    control_rate: float = _pos(
+        500.0, "Hz", "rate of the zeros while wrenches are stale; nominal cycle of the rate limits"
+    )
+    status_rate: float = _pos(50.0, "Hz", "`~status` publish rate")
+    wrench_timeout: float = _pos(
+        0.1, "s", "no wrench for longer: output zero (SAFETY_STALE); the floor when the rate is measured"
+    )
+    wrench_timeout_periods: float = _nonneg(
+        10.0, "", "stale after this many measured sample periods if that is longer (0: fixed timeout)"
+    )
+    no_data_end_timeout: float = param(
+        1.0, unit="s", ge=0.0, shown_range="0 or >= `wrench_timeout`",
+        doc="stale this long ends the move with NO_FT_DATA (0: at once)",
+    )
+    check_stamp_age: bool = param(
+        True,
+        doc="wrenches stamped more than `wrench_timeout` ago are stale (false for sensors with another "
+        "clock)",
+    )
+    future_stamp_tolerance: float = _nonneg(
+        0.1, "s", "with `check_stamp_age`: a stamp further ahead of the node's clock is refused like NaN"
+    )
+    publish_when_idle: bool = param(False, doc="publish zero twists when no move is active")
+    idle_zero_count: float = _nonneg(10.0, "", "zero twists sent after a move ends, then silence")
+    publish_synchronously: bool = param(
+        True, doc="send the twist from the wrench callback, no sender thread (see *Node*; new)"
+    )
+    # wrench preprocessing
+    lp_filter_enabled: bool = param(True, doc="second-order Butterworth low-pass on the wrench")
+    lp_filter_delta_t: float = _pos(
+        0.002, "s", "expected sample period: the filter's design until the rate is measured (fork: 0.2 s)"
+    )
+    lp_filter_cutoff_freq: float = param(
+        5.0, unit="Hz", gt=0.0, shown_range="> 0, < 0.5 / `lp_filter_delta_t`",
+        doc="cutoff, true at the measured rate with `lp_filter_rate_adapt` (fork: 0.6 Hz)",
+    )
+    lp_filter_rate_adapt: bool = param(
+        True, doc="design the filter for the measured sample period (`lp_filter_delta_t` until known)"
+    )
+    ft_x_direction: int = _sign(
+        "legacy sign flip of sensor force X and torque X (original Panda: -1; prefer correct tf frames)"
+    )
+    ft_y_direction: int = _sign("legacy sign flip of sensor force Y and torque Y")
+    ft_z_direction: int = _sign("legacy sign flip of sensor force Z and torque Z")
+    travel_x_direction: int = _sign("legacy sign flip of the measured travel along X and about X")
+    travel_y_direction: int = _sign("legacy sign flip of the measured travel along Y and about Y")
+    travel_z_direction: int = _sign(
+        "legacy sign flip of the measured travel along Z and about Z (original Panda: -1)"
+    )
+    tare_on_startup: bool = param(True, doc="tare with the first valid wrench")
+    bias: tuple[float, ...] = param(
+        (0.0,) * 6, type="floats", length=6, unit="N, Nm",
+        doc="known sensor offset (sensor frame) subtracted until the first tare",
+    )
+    tool_mass: float = _nonneg(
+        0.0, "kg", "payload below the sensor, gravity-compensated (the robot package's description.args "
+        "`--tool-mass`)"
+    )
+    tool_com: tuple[float, ...] = param(
+        (0.0, 0.0, 0.0), type="floats", length=3, unit="m",
+        doc="payload centre of mass in the sensor frame (description.args `--tool-com`)",
+    )
+    gravity: tuple[float, ...] = param(
+        (0.0, 0.0, -9.81), type="floats", length=3, unit="m/s^2", doc="gravity in `fixed_frame`"
+    )
+    force_deadband: float = _nonneg(0.0, "N", "force components below this read as zero (control frame)")
+    torque_deadband: float = _nonneg(0.0, "Nm", "same for torques")
+    # global limits
+    global_max_force: float = _pos(25.0, "N", "|force| above this: zero output, latched until `~reset`")
+    global_max_torque: float = _pos(25.0, "Nm", "|torque| above this: same")
+    max_velocity: float = _pos(0.25, "m/s", "clamp of every linear velocity; compliant move speed range")
+    max_angular_velocity: float | None = param(
+        None, type="float", optional=True, gt=0.0, unit="rad/s", shown_default="= `max_velocity`",
+        doc="clamp of angular velocities (unset: `max_velocity`, the original's one clamp for all axes)",
+    )
+    # law tuning (the thesis fork's hard-coded numbers, named)
+    follower_deadband_force: float = _nonneg(2.5, "N", "follower ignores smaller forces (decelerates)")
+    follower_deadband_torque: float = _nonneg(2.5, "Nm", "same for torques")
+    min_velocity_linear: float = param(
+        0.005, unit="m/s", ge=0.0, shown_range=">= 0, < `max_velocity`",
+        doc="commands of at most this magnitude become zero",
+    )
+    min_velocity_angular: float = param(
+        0.005, unit="rad/s", ge=0.0, shown_range=">= 0, < the angular clamp", doc="same for rotations"
+    )
+    acceleration_linear: float = _pos(2.5, "m/s^2", "limit on speeding up")
+    acceleration_angular: float = _pos(2.5, "rad/s^2", "same for rotations")
+    deceleration_linear: float = _pos(2.5, "m/s^2", "limit on slowing down (fork: 0.005 m/s per 2 ms cycle)")
+    deceleration_angular: float = _pos(2.5, "rad/s^2", "same for rotations")
+    spring_output_scale: float = _pos(0.2, "", "spring velocity factor (fork: 0.2)")
+    spring_rounding: float = _nonneg(0.01, "N, m/s", "spring rounds force and velocity to this step (0: off)")
+    compliant_slowdown_distance: float = _nonneg(0.02, "m", "compliant move slows down this near max travel")
+    compliant_slowdown_angle: float = _nonneg(0.02, "rad", "same for rotations")
+    compliant_approach_speed_linear: float = param(
+        0.02, unit="m/s", gt=0.0, shown_range="> `min_velocity_linear`",
+        doc="slowest compliant move speed when slowing down",
+    )
+    compliant_approach_speed_angular: float = param(
+        0.02, unit="rad/s", gt=0.0, shown_range="> `min_velocity_angular`", doc="same for rotations"
+    )
+    compliant_default_velocity_linear: float = param(
+        0.01, unit="m/s", gt=0.0, shown_range="> `min_velocity_linear`, <= `max_velocity`",
+        doc="V_desired of a compliant move requested without one, toward its force limit's sign",
+    )
+    compliant_default_velocity_angular: float = param(
+        0.05, unit="rad/s", gt=0.0, shown_range="> `min_velocity_angular`, <= the angular clamp",
+        doc="same for rotations",
+    )
+    # exceeded_action move_away (after a move ended on a force/torque limit)
+    move_away_velocity_linear: float = param(
+        0.01, unit="m/s", gt=0.0, shown_range="> `min_velocity_linear`, <= `max_velocity`",
+        doc="backing-off speed of `exceeded_action: move_away`, along the contact force",
+    )
+    move_away_velocity_angular: float = param(
+        0.05, unit="rad/s", gt=0.0, shown_range="> `min_velocity_angular`, <= the angular clamp",
+        doc="same for rotations",
+    )
+    move_away_release_fraction: float = param(
+        0.5, gt=0.0, lt=1.0, unit="fraction of the axis's limit",
+        doc="backing off ends once |F| is below this fraction of the axis's force/torque limit "
+        "(hysteresis: it started at the limit)",
+    )
+    move_away_max_distance: float = _pos(
+        0.02, "m", "backing off ends after this much commanded travel at the latest"
+    )
+    move_away_max_angle: float = _pos(0.2, "rad", "same for rotations")
+    # force tracking law (ConfigureLaws FORCE_TRACKING)
+    force_tracking_deadband_force: float = _nonneg(
+        0.2, "N",
+        "force tracking holds still while |F - target| is at most this (no deadband around zero force)",
+    )
+    force_tracking_deadband_torque: float = _nonneg(0.02, "Nm", "same for torques")
+    force_tracking_contact_fraction: float = param(
+        0.5, gt=0.0, le=1.0, unit="fraction of the target",
+        doc="force tracking is out of contact, and approaches at least at its approach speed, while F is "
+        "short of this fraction of the target",
+    )
+    diff_max_force: float = _nonneg(
+        0.0, "N", "force change within `diff_window` that ends a move (force-jump end condition; 0: off)"
+    )
+    diff_max_torque: float = _nonneg(0.0, "Nm", "same for torques")
+    diff_window: float = _pos(0.1, "s", "time window of the force-jump check")
+    force_limit_arm_time: float = _nonneg(
+        0.5, "s",
+        "force/torque limits (FT_VIOLATION) are checked from this long after the axes start from rest (the "
+        "law is set, or motion resumes after a safety hold), or once an axis has reached its law's velocity: "
+        "a 1 kg tool speeding up at 0.5 m/s² reads 0.5 N on a wrist sensor, the thesis's whole limit. The "
+        "law itself still slows down on contact meanwhile. 0 always checks, as the fork did",
+    )
 
     @property
     def ft_directions(self) -> tuple[int, int, int]:
@@ -277,41 +262,31 @@ class ContactControlSettings:
         )
 
 
-def _number(key: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ParamError(key, f"expected a number, got {value!r}")
-    value = float(value)
-    if not math.isfinite(value):
-        raise ParamError(key, f"must be finite, got {value}")
-    return value
+@dataclass(frozen=True)
+class AxisTuning:
+    """Law tuning for one kind of axis (linear: N, m, m/s; angular: Nm, rad, rad/s).
+
+    `ContactControlSettings.tuning` builds it from the parameters; the defaults are the linear parameters'.
+    """
+
+    deadband: float = ContactControlSettings.follower_deadband_force
+    min_velocity: float = ContactControlSettings.min_velocity_linear
+    acceleration: float = ContactControlSettings.acceleration_linear
+    deceleration: float = ContactControlSettings.deceleration_linear
+    max_velocity: float = ContactControlSettings.max_velocity
+    slowdown: float = ContactControlSettings.compliant_slowdown_distance
+    approach_speed: float = ContactControlSettings.compliant_approach_speed_linear
+    diff_max: float = ContactControlSettings.diff_max_force
+    spring_scale: float = ContactControlSettings.spring_output_scale
+    spring_rounding: float = ContactControlSettings.spring_rounding
+    default_velocity: float = ContactControlSettings.compliant_default_velocity_linear
+    away_velocity: float = ContactControlSettings.move_away_velocity_linear
+    away_max_travel: float = ContactControlSettings.move_away_max_distance
+    track_deadband: float = ContactControlSettings.force_tracking_deadband_force
+    contact_fraction: float = ContactControlSettings.force_tracking_contact_fraction
 
 
-def _convert(key: str, kind: str, value: Any) -> Any:
-    if kind == "str":
-        if not isinstance(value, str):
-            raise ParamError(key, f"expected a string, got {value!r}")
-        return value
-    if kind == "bool":
-        if not isinstance(value, bool):
-            raise ParamError(key, f"expected true or false, got {value!r}")
-        return value
-    if kind in ("vec3", "vec6"):
-        size = 3 if kind == "vec3" else 6
-        if not isinstance(value, list | tuple) or len(value) != size:
-            raise ParamError(key, f"expected a list of {size} numbers, got {value!r}")
-        return tuple(_number(key, v) for v in value)
-    if kind == "optpos" and value is None:
-        return None
-    number = _number(key, value)
-    if kind == "sign":
-        if number not in (1.0, -1.0):
-            raise ParamError(key, f"must be 1 or -1, got {value!r}")
-        return int(number)
-    if kind in ("pos", "optpos") and number <= 0.0:
-        raise ParamError(key, f"must be > 0, got {value!r}")
-    if kind == "nonneg" and number < 0.0:
-        raise ParamError(key, f"must be >= 0, got {value!r}")
-    return number
+PARAMETERS = schema_of(ContactControlSettings)
 
 
 def load_settings(params: Mapping[str, Any] | None = None) -> ContactControlSettings:
@@ -322,10 +297,11 @@ def load_settings(params: Mapping[str, Any] | None = None) -> ContactControlSett
             original YAML; top-level keys win over nested ones. Missing keys take their defaults.
 
     Returns:
-        The settings; `unknown_keys` lists input keys that are not parameters.
+        The settings.
 
     Raises:
-        ParamError: a value has the wrong type, is out of range, or breaks a cross-constraint.
+        ParamError: an unknown key (naming the closest valid one), a value of the wrong type or out of
+            range, or a broken cross-constraint.
     """
     merged: dict[str, Any] = {}
     params = dict(params or {})
@@ -335,21 +311,17 @@ def load_settings(params: Mapping[str, Any] | None = None) -> ContactControlSett
             raise ParamError("contact_control", "expected a dictionary of parameters")
         merged.update(nested)
     merged.update(params)
-    values: dict[str, Any] = {}
-    for key, (kind, _default, _unit, _doc) in PARAMETERS.items():
-        if key in merged:
-            values[key] = _convert(key, kind, merged[key])
-    unknown = tuple(sorted(k for k in merged if k not in PARAMETERS))
-    if unknown:
-        raise ParamError(unknown[0], unknown_key_message(unknown[0], PARAMETERS))
-    names = {f.name for f in fields(ContactControlSettings)}
-    assert names >= set(PARAMETERS), "PARAMETERS and ContactControlSettings disagree"
-    settings = ContactControlSettings(**values, unknown_keys=unknown)
+    try:
+        values = PARAMETERS.load(merged)
+    except SchemaError as err:
+        raise ParamError(err.key, err.message) from None
+    settings = ContactControlSettings(**PARAMETERS.attrs(values))
     _check_cross_constraints(settings)
     return settings
 
 
 def _check_cross_constraints(s: ContactControlSettings) -> None:
+    """Relations between parameters (each one's own range is in its declaration)."""
     if s.lp_filter_enabled and s.lp_filter_cutoff_freq * s.lp_filter_delta_t >= 0.5:
         raise ParamError(
             "lp_filter_cutoff_freq",
@@ -371,9 +343,5 @@ def _check_cross_constraints(s: ContactControlSettings) -> None:
             # Not above the clamp (it would be cut anyway), above min velocity (it would never move).
             if not t.min_velocity < value <= t.max_velocity:
                 raise ParamError(key, f"must exceed min_velocity_{suffix} and not exceed {t.max_velocity}")
-    if s.force_tracking_contact_fraction > 1.0:
-        raise ParamError("force_tracking_contact_fraction", "must be at most 1 (a fraction of the target)")
-    if s.move_away_release_fraction >= 1.0:
-        raise ParamError("move_away_release_fraction", "must be below 1 (a fraction of the force limit)")
     if s.no_data_end_timeout and s.no_data_end_timeout < s.wrench_timeout:
         raise ParamError("no_data_end_timeout", "must be 0 or at least wrench_timeout")

@@ -8,15 +8,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, fields
 from typing import Any
 
-from compliant_common.keys import unknown_key_message
+from compliant_common.schema import SchemaError, param, schema_of
 
 __all__ = [
     "COMMAND_IN_TYPES",
     "COMMAND_OUT_TYPES",
     "INTEGRATE_FROM",
+    "PARAMETERS",
     "JogSettings",
     "JointLimitOverride",
     "SettingsError",
@@ -65,57 +66,144 @@ class JointLimitOverride:
     max_acceleration: float | None = None
 
 
+def _pos(default: float, unit: str, doc: str) -> Any:
+    return param(default, unit=unit, gt=0.0, doc=doc)
+
+
+def _nonneg(default: float, unit: str, doc: str) -> Any:
+    return param(default, unit=unit, ge=0.0, doc=doc)
+
+
+def _topic(default: str, doc: str = "") -> Any:
+    return param(default, nonempty=True, doc=doc)
+
+
 @dataclass(frozen=True)
 class JogSettings:
-    """All jog_arm parameters with their units. Build with :meth:`from_params`, which validates.
+    """All jog_arm parameters, each declared once here (name, type, default, unit, range, doc).
 
-    Names are the 2018 fork's where it had one (see the package README for each key).
+    Build with :meth:`from_params`, which validates. Names are the 2018 fork's where it had one.
     """
 
     # --- the fork's parameters ---
-    move_group_name: str = "manipulator"  # kept for compatibility; there is no MoveIt here
-    scale_linear: float = 0.4  # [m/s] speed of a unitless command of 1.0
-    scale_rotational: float = 0.8  # [rad/s] angular speed of a unitless command of 1.0
-    low_pass_filter_coeff: float = 2.0  # [-] >= 1; larger smooths more
-    joint_topic: str = "joint_states"
-    cmd_in_topic: str = "jog_arm_server/delta_jog_cmds"
-    cmd_frame: str = ""  # frame of commands whose header has none; "" = planning_frame
-    incoming_cmd_timeout: float = 1.0  # [s]
-    joint_state_timeout: float = 0.2  # [s] a joint state older than this halts (STALE_JOINT_STATE)
-    cmd_out_topic: str = "arm_controller/command"
-    singularity_threshold: float = 7.0  # [-] condition number where slowing starts
-    hard_stop_singularity_threshold: float = 12.0  # [-] condition number where motion stops
-    singularity_length_scale: float = 0.4  # [m] linear Jacobian rows are divided by it (1.0 = raw)
-    planning_frame: str = "base_link"
-    pub_period: float = 0.01  # [s]
-    simu: bool = False
+    move_group_name: str = param("manipulator", doc="kept for old configs; unused (no MoveIt)")
+    scale_linear: float = param(
+        0.4, key="scale/linear", unit="m/s", gt=0.0,
+        doc="speed of a unitless 1.0 (the fork's value was metres per publish period)",
+    )
+    scale_rotational: float = param(
+        0.8, key="scale/rotational", unit="rad/s", gt=0.0, doc="angular speed of a unitless 1.0"
+    )
+    low_pass_filter_coeff: float = param(
+        2.0, ge=1.0,
+        doc="filter coefficient c: `y = (x + x₋₁ - (1-c) y₋₁)/(1+c)`, time constant ~c/2 cycles; larger "
+        "smooths more (smaller than 1 makes the filter ring)",
+    )
+    joint_topic: str = _topic("joint_states", "sensor_msgs/JointState input")
+    cmd_in_topic: str = _topic("jog_arm_server/delta_jog_cmds", "geometry_msgs/TwistStamped input")
+    cmd_frame: str = param(
+        "", doc="frame of commands with an empty `header.frame_id`; `\"\"` = `planning_frame`"
+    )
+    incoming_cmd_timeout: float = _pos(
+        1.0, "s",
+        "no command this long: stop (UR5 real 1, UR5 sim 5, Panda 0.3 in the fork; the robot packages use "
+        "0.1)",
+    )
+    joint_state_timeout: float = _pos(
+        0.2, "s", "no joint state this long: stop (STALE_JOINT_STATE); several periods of the state's rate"
+    )
+    cmd_out_topic: str = _topic("arm_controller/command", "joint command output (see `command_out_type`)")
+    singularity_threshold: float = param(
+        7.0, ge=1.0, doc="condition number where slowing starts"
+    )
+    hard_stop_singularity_threshold: float = param(
+        12.0, shown_range=">= `singularity_threshold`", doc="condition number where motion stops"
+    )
+    singularity_length_scale: float = _pos(
+        0.4, "m", "linear Jacobian rows are divided by it before the condition number (1.0 = raw)"
+    )
+    planning_frame: str = param(
+        "base_link", nonempty=True,
+        doc="URDF frame of the reported pose, the default command frame and tf lookups",
+    )
+    pub_period: float = _pos(0.01, "s", "control and publish period")
+    simu: bool = param(False, doc="several trajectory points per message (`simu_points`)")
     # --- ours ---
-    ee_frame_name: str = "tool0"
-    joint_names: tuple[str, ...] = ()  # () = every joint from the root to ee_frame_name
-    command_in_type: str = "unitless"
-    command_out_type: str = "trajectory"
-    simu_points: int = 5  # trajectory points per message in simu mode
-    num_outgoing_halt_msgs_to_publish: int = 10
-    joint_limit_margin: float = 0.1  # [rad] never closer to a position limit than this
-    joint_limit_slowdown_width: float = 0.2  # [rad] ramp-down zone before the margin
-    default_max_acceleration: float = 3.0  # [rad/s²] for joints without an override
-    joint_limits: Mapping[str, JointLimitOverride] = field(default_factory=dict)
-    pinv_damping: float = 0.02  # [-] largest damping of the pseudo-inverse
-    pinv_damping_threshold: float = 0.05  # [-] smallest singular value below which damping starts
-    nullspace_gain: float = 1.0  # [1/s] pull of the redundant motion toward the posture
-    nullspace_posture: tuple[float, ...] = ()  # () = posture held when motion starts
-    integrate_from: str = "commanded"
-    max_tracking_error: float = 0.2  # [rad] re-sync to the measured state beyond this; 0 = never
-    publish_on_command: bool = False  # also run a cycle when a twist arrives (lowest latency)
-    publish_synchronously: bool = False  # write the command socket in the cycle's thread (no sender thread)
+    ee_frame_name: str = param("tool0", nonempty=True, doc="URDF frame commanded (tool centre point)")
+    joint_names: tuple[str, ...] = param(
+        (), type="strings", shown_range="no duplicates",
+        doc="controlled joints in output order; `[]` = all joints from the root to `ee_frame_name`; others "
+        "are locked at 0",
+    )
+    command_in_type: str = param(
+        "unitless", choices=COMMAND_IN_TYPES, doc="speed_units: m/s and rad/s, as contact_control sends"
+    )
+    command_out_type: str = param(
+        "trajectory", choices=COMMAND_OUT_TYPES, doc="JointTrajectory or Float64MultiArray"
+    )
+    simu_points: int = param(5, ge=1, doc="points per trajectory in simu mode")
+    num_outgoing_halt_msgs_to_publish: int = param(
+        10, ge=1, doc="times the final zero command is sent"
+    )
+    joint_limit_margin: float = _nonneg(0.1, "rad", "distance kept from each position limit")
+    joint_limit_slowdown_width: float = _nonneg(0.2, "rad", "ramp-down zone before the margin")
+    default_max_acceleration: float = _pos(
+        3.0, "rad/s²", "for joints without an override (URDFs carry none)"
+    )
+    joint_limits: Mapping[str, JointLimitOverride] = param(
+        {}, type="mapping", unit="rad, rad/s, rad/s²", shown_default="URDF",
+        doc="per-joint overrides `<joint>: {min_position, max_position, max_velocity, max_acceleration}`; "
+        "`max_velocity` is required for a joint whose URDF gives none (or 0), typically a continuous one; "
+        "continuous joints have no position limits unless set here",
+    )
+    pinv_damping: float = _nonneg(0.02, "", "largest damping λ of the pseudo-inverse")
+    pinv_damping_threshold: float = _nonneg(0.05, "", "smallest singular value below which damping starts")
+    nullspace_gain: float = _nonneg(
+        1.0, "1/s", "pull of the self-motion toward the posture (arms with > 6 joints)"
+    )
+    nullspace_posture: tuple[float, ...] = param(
+        (), type="floats", unit="rad", shown_range="one per joint",
+        doc="one value per joint; `[]` = posture when motion starts",
+    )
+    integrate_from: str = param("commanded", choices=INTEGRATE_FROM, doc="reference of the next point")
+    max_tracking_error: float = _nonneg(
+        0.2, "rad", "commanded vs measured beyond this: restart from measured; 0 = never"
+    )
+    publish_on_command: bool = param(
+        False,
+        doc="also run a cycle (and publish) the moment a twist arrives, instead of waiting for the next "
+        "timer tick; no timer then: a gap filler thread sleeps while twists come and runs a cycle 2.5 "
+        "`pub_period` after the last twist-driven one, then one per `pub_period` until twists return "
+        "(halting); a late or single missing twist gets no duplicate, older command. Lowest latency when "
+        "commands come at about `1/pub_period` (contact_control)",
+    )
+    publish_synchronously: bool = param(
+        False,
+        doc="write the joint command to the subscribers' sockets inside the cycle instead of through rospy's "
+        "sender thread per subscriber: about 90 µs less latency and less CPU, but a subscriber that stops "
+        "reading (`rostopic echo | less`) then blocks the node's cycles, leaving a velocity controller "
+        "without a watchdog on its last command. Turn on only when the robot side stops by itself when "
+        "commands stop (the MuJoCo driver's `command_timeout`); the sim configs do",
+    )
     # contact-force guard on twists from outside sources (keyboard, rostopic pub; see contact_guard.py)
-    contact_guard_enabled: bool = True
-    contact_guard_max_force: float = 20.0  # [N] motion into the contact stops at this contact force
-    contact_guard_slow_force: float = 2.0  # [N] motion into the contact is slowed from this force on
-    contact_guard_slow_speed: float = 0.01  # [m/s] into-contact speed cap at slow_force (0 at max_force)
-    contact_guard_timeout: float = 0.25  # [s] an older contact force stops outside twists
-    contact_guard_relief_speed: float = 0.005  # [m/s] at max_force a push into the contact backs off at this
-    contact_guard_wrench_topic: str = "contact_control_node/contact_wrench"  # two-node layout's force input
+    contact_guard_enabled: bool = param(
+        True, doc="the [contact-force guard](#contact-force-guard) on outside twists"
+    )
+    contact_guard_max_force: float = _pos(20.0, "N", "motion into a contact stops at this contact force")
+    contact_guard_slow_force: float = param(
+        2.0, unit="N", ge=0.0, shown_range=">= 0, < `contact_guard_max_force`",
+        doc="from this contact force motion into the contact is slowed",
+    )
+    contact_guard_slow_speed: float = _pos(
+        0.01, "m/s", "into-contact speed cap at `contact_guard_slow_force`, falling to 0 at the max"
+    )
+    contact_guard_timeout: float = _pos(0.25, "s", "a contact force older than this stops outside twists")
+    contact_guard_relief_speed: float = _pos(
+        0.005, "m/s", "at the max force a push into the contact backs off at this instead"
+    )
+    contact_guard_wrench_topic: str = param(
+        "contact_control_node/contact_wrench", doc="two-node layout: where the contact force comes from"
+    )
 
     @classmethod
     def from_params(cls, params: Mapping[str, Any], prefix: str = "jog_arm_server/") -> JogSettings:
@@ -139,120 +227,50 @@ class JogSettings:
     def from_params_with_warnings(
         cls, params: Mapping[str, Any], prefix: str = "jog_arm_server/"
     ) -> tuple[JogSettings, list[str]]:
-        """Like :meth:`from_params`, also returning warnings about unknown or renamed keys."""
+        """Like :meth:`from_params`, also returning warnings about renamed keys (MoveIt Servo's)."""
         flat = flatten_params(params)
         warnings: list[str] = []
-        known = {_key_of(f.name) for f in fields(cls)}
+        given: dict[str, Any] = {}
         for key in sorted(flat):
-            if key in known or key in _NODE_ONLY or key.startswith("joint_limits/"):
-                continue
             base = key.split("/")[0]
-            if key in _RENAMED or base in _RENAMED:
+            if key in PARAMETERS or key in _NODE_ONLY or key.startswith("joint_limits/"):
+                given[key] = flat[key]
+            elif key in _RENAMED or base in _RENAMED:
                 new = _RENAMED.get(key, _RENAMED.get(base))
                 hint = f"use {prefix}{new}" if new else "not supported, ignored"
                 warnings.append(f"{prefix}{key} is a renamed or unsupported key: {hint}")
             else:
-                raise SettingsError(unknown_key_message(key, known | set(_NODE_ONLY), prefix))
-
-        reader = _Reader(flat, prefix)
-        defaults = cls()
-        values: dict[str, Any] = {}
-        for f in fields(cls):
-            key = _key_of(f.name)
-            default = getattr(defaults, f.name)
-            if f.name == "joint_limits":
-                values[f.name] = _read_joint_limits(flat, prefix)
-            elif isinstance(default, bool):
-                values[f.name] = reader.boolean(key, default)
-            elif isinstance(default, int):
-                values[f.name] = reader.integer(key, default)
-            elif isinstance(default, float):
-                values[f.name] = reader.number(key, default)
-            elif isinstance(default, str):
-                values[f.name] = reader.text(key, default)
-            elif f.name == "joint_names":
-                values[f.name] = reader.names(key)
-            elif f.name == "nullspace_posture":
-                values[f.name] = reader.numbers(key)
-        settings = cls(**values)
+                given[key] = flat[key]
+        scalars = {k: v for k, v in given.items() if not k.startswith("joint_limits/")}
+        try:
+            values = PARAMETERS.load(scalars, prefix, also_known=_NODE_ONLY)
+        except SchemaError as err:
+            raise SettingsError(_message(prefix, err)) from None
+        values["joint_limits"] = _read_joint_limits(given, prefix)
+        settings = cls(**PARAMETERS.attrs(values))
         settings.validate(prefix)
         return settings, warnings
 
     def validate(self, prefix: str = "jog_arm_server/") -> None:
-        """Checks ranges and cross-constraints.
+        """Checks each parameter's range (its declaration) and the relations between parameters.
 
         Raises:
             SettingsError: Naming the first offending key.
         """
-
-        def positive(name: str) -> None:
-            if not getattr(self, name) > 0.0:
-                raise SettingsError(f"{prefix}{_key_of(name)} must be > 0, got {getattr(self, name)}")
-
-        def non_negative(name: str) -> None:
-            if not getattr(self, name) >= 0.0:
-                raise SettingsError(f"{prefix}{_key_of(name)} must be >= 0, got {getattr(self, name)}")
-
-        for name in (
-            "scale_linear",
-            "scale_rotational",
-            "incoming_cmd_timeout",
-            "joint_state_timeout",
-            "pub_period",
-            "singularity_threshold",
-            "singularity_length_scale",
-            "default_max_acceleration",
-        ):
-            positive(name)
-        for name in (
-            "joint_limit_margin",
-            "joint_limit_slowdown_width",
-            "pinv_damping",
-            "pinv_damping_threshold",
-            "nullspace_gain",
-            "max_tracking_error",
-        ):
-            non_negative(name)
-        if self.num_outgoing_halt_msgs_to_publish < 1:
-            raise SettingsError(
-                f"{prefix}num_outgoing_halt_msgs_to_publish must be >= 1 (the final zero command is sent "
-                f"that many times), got {self.num_outgoing_halt_msgs_to_publish}"
-            )
-        if self.singularity_threshold < 1.0:
-            raise SettingsError(
-                f"{prefix}singularity_threshold must be >= 1 (a condition number), "
-                f"got {self.singularity_threshold}"
-            )
+        try:
+            PARAMETERS.check(PARAMETERS.values_of(self))
+        except SchemaError as err:
+            raise SettingsError(_message(prefix, err)) from None
         if self.hard_stop_singularity_threshold < self.singularity_threshold:
             raise SettingsError(
                 f"{prefix}hard_stop_singularity_threshold ({self.hard_stop_singularity_threshold}) "
                 f"must be >= {prefix}singularity_threshold ({self.singularity_threshold})"
             )
-        if self.low_pass_filter_coeff < 1.0:
+        if not self.contact_guard_slow_force < self.contact_guard_max_force:
             raise SettingsError(
-                f"{prefix}low_pass_filter_coeff must be >= 1 (smaller values make the filter ring), "
-                f"got {self.low_pass_filter_coeff}"
-            )
-        for name in ("contact_guard_max_force", "contact_guard_slow_speed", "contact_guard_timeout",
-                     "contact_guard_relief_speed"):
-            positive(name)
-        if not 0.0 <= self.contact_guard_slow_force < self.contact_guard_max_force:
-            raise SettingsError(
-                f"{prefix}contact_guard_slow_force must be >= 0 and below contact_guard_max_force "
+                f"{prefix}contact_guard_slow_force must be below contact_guard_max_force "
                 f"({self.contact_guard_max_force} N), got {self.contact_guard_slow_force}"
             )
-        if self.simu_points < 1:
-            raise SettingsError(f"{prefix}simu_points must be >= 1, got {self.simu_points}")
-        for name, allowed in (
-            ("command_in_type", COMMAND_IN_TYPES),
-            ("command_out_type", COMMAND_OUT_TYPES),
-            ("integrate_from", INTEGRATE_FROM),
-        ):
-            if getattr(self, name) not in allowed:
-                raise SettingsError(f"{prefix}{name} must be one of {allowed}, got {getattr(self, name)!r}")
-        for name in ("ee_frame_name", "planning_frame", "cmd_in_topic", "cmd_out_topic", "joint_topic"):
-            if not getattr(self, name):
-                raise SettingsError(f"{prefix}{name} must not be empty")
         if len(set(self.joint_names)) != len(self.joint_names):
             raise SettingsError(f"{prefix}joint_names has duplicates: {list(self.joint_names)}")
         posture, names = self.nullspace_posture, self.joint_names
@@ -268,10 +286,14 @@ class JogSettings:
         return self.cmd_frame or self.planning_frame
 
 
-def _key_of(field_name: str) -> str:
-    """Parameter key of a settings field (the `scale/*` pair is nested like the fork's YAML)."""
-    nested = {"scale_linear": "scale/linear", "scale_rotational": "scale/rotational"}
-    return nested.get(field_name, field_name)
+PARAMETERS = schema_of(JogSettings)
+
+
+def _message(prefix: str, err: SchemaError) -> str:
+    """The schema's error with the key prefixed ("jog_arm_server/pub_period: must be > 0, got 0.0")."""
+    if err.message.startswith(f"{prefix}{err.key} "):  # the unknown-key message names the key itself
+        return err.message
+    return f"{prefix}{err.key}: {err.message}"
 
 
 def flatten_params(params: Mapping[str, Any], base: str = "") -> dict[str, Any]:
@@ -289,55 +311,6 @@ def flatten_params(params: Mapping[str, Any], base: str = "") -> dict[str, Any]:
     return flat
 
 
-class _Reader:
-    """Typed access to flat parameters with errors that name the key."""
-
-    def __init__(self, flat: Mapping[str, Any], prefix: str) -> None:
-        self._flat = flat
-        self._prefix = prefix
-
-    def _get(self, key: str, default: Any) -> Any:
-        return self._flat.get(key, default)
-
-    def number(self, key: str, default: float) -> float:
-        value = self._get(key, default)
-        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-            raise SettingsError(f"{self._prefix}{key} must be a finite number, got {value!r}")
-        return float(value)
-
-    def integer(self, key: str, default: int) -> int:
-        value = self._get(key, default)
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise SettingsError(f"{self._prefix}{key} must be an integer, got {value!r}")
-        return value
-
-    def boolean(self, key: str, default: bool) -> bool:
-        value = self._get(key, default)
-        if not isinstance(value, bool):
-            raise SettingsError(f"{self._prefix}{key} must be true or false, got {value!r}")
-        return value
-
-    def text(self, key: str, default: str) -> str:
-        value = self._get(key, default)
-        if not isinstance(value, str):
-            raise SettingsError(f"{self._prefix}{key} must be a string, got {value!r}")
-        return value
-
-    def names(self, key: str) -> tuple[str, ...]:
-        value = self._get(key, [])
-        if not isinstance(value, list | tuple) or not all(isinstance(v, str) and v for v in value):
-            raise SettingsError(f"{self._prefix}{key} must be a list of joint names, got {value!r}")
-        return tuple(value)
-
-    def numbers(self, key: str) -> tuple[float, ...]:
-        value = self._get(key, [])
-        if not isinstance(value, list | tuple) or not all(
-            isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v) for v in value
-        ):
-            raise SettingsError(f"{self._prefix}{key} must be a list of finite numbers, got {value!r}")
-        return tuple(float(v) for v in value)
-
-
 def _read_joint_limits(flat: Mapping[str, Any], prefix: str) -> dict[str, JointLimitOverride]:
     limits: dict[str, JointLimitOverride] = {}
     allowed = {f.name for f in fields(JointLimitOverride)}
@@ -352,8 +325,16 @@ def _read_joint_limits(flat: Mapping[str, Any], prefix: str) -> dict[str, JointL
             raise SettingsError(
                 f"{prefix}{key} has unknown keys {sorted(unknown)}; allowed: {sorted(allowed)}"
             )
-        reader = _Reader(dict(value), f"{prefix}{key}/")
-        entry = {name: reader.number(name, 0.0) if name in value else None for name in allowed}
+        entry: dict[str, float | None] = {}
+        for name in sorted(allowed):
+            if name not in value:
+                entry[name] = None
+            elif isinstance(value[name], bool) or not isinstance(value[name], int | float) or not (
+                math.isfinite(value[name])
+            ):
+                raise SettingsError(f"{prefix}{key}/{name} must be a finite number, got {value[name]!r}")
+            else:
+                entry[name] = float(value[name])
         override = JointLimitOverride(**entry)
         for name in ("max_velocity", "max_acceleration"):
             number = getattr(override, name)

@@ -16,10 +16,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from typing import Any, NamedTuple
 
-from compliant_common.keys import unknown_key_message
+from compliant_common.schema import SchemaError, param, schema_of
 
 from keyboard_publisher.keymap import KEYMAP, Action, Binding
 
@@ -44,23 +44,6 @@ MIN_SPEED_FRACTION = 0.01
 # Typical keyboard auto-repeat delay; a shorter key_timeout stops motion before the first repeat arrives.
 TYPICAL_REPEAT_DELAY = 0.5
 
-# name: (default, unit, description) -- the table the README documents.
-PARAMETERS: dict[str, tuple[Any, str, str]] = {
-    "topic": ("jog_arm_server/delta_jog_cmds", "", "geometry_msgs/TwistStamped output (relative name)"),
-    "frame_id": ("", "", "header.frame_id of the twist (empty like the original: the receiver's default)"),
-    "key_event_topic": ("keyboard_publisher/key_event", "", "keyboard_publisher/KeyEvent output"),
-    "linear_speed": (0.2, "m/s", "initial linear speed (the original's fixed 0.2 m/s)"),
-    "max_linear_speed": (0.5, "m/s", "upper bound of the linear speed keys"),
-    "angular_speed": (0.3, "rad/s", "initial angular speed"),
-    "max_angular_speed": (1.0, "rad/s", "upper bound of the angular speed keys"),
-    "speed_step": (1.1, "", "factor (> 1) one speed key press multiplies or divides the speed by"),
-    "rate": (50.0, "Hz", "publish rate while moving"),
-    "key_timeout": (0.6, "s", "deadman: zero when no motion key came for this long (> the repeat delay)"),
-    "repeat_timeout": (0.15, "s", "deadman once the key auto-repeats (> a few repeat periods, ~33 ms each)"),
-    "stop_repeats": (3, "", "zero twists sent after a stop or a timeout, then silence"),
-}
-
-
 class SettingsError(ValueError):
     """A parameter has a wrong type or range; `key` names it."""
 
@@ -69,53 +52,66 @@ class SettingsError(ValueError):
         self.key = key
 
 
+def _speed_range(limit: str) -> str:
+    return f"in [{MIN_SPEED_FRACTION:g} x `~{limit}`, `~{limit}`]"
+
+
 @dataclass(frozen=True)
 class TeleopSettings:
-    """Validated parameters of key_to_twist (units in `PARAMETERS`)."""
+    """Validated parameters of key_to_twist, each declared once here (name, type, default, unit, range, doc).
 
-    topic: str = PARAMETERS["topic"][0]
-    frame_id: str = PARAMETERS["frame_id"][0]
-    key_event_topic: str = PARAMETERS["key_event_topic"][0]
-    linear_speed: float = PARAMETERS["linear_speed"][0]
-    max_linear_speed: float = PARAMETERS["max_linear_speed"][0]
-    angular_speed: float = PARAMETERS["angular_speed"][0]
-    max_angular_speed: float = PARAMETERS["max_angular_speed"][0]
-    speed_step: float = PARAMETERS["speed_step"][0]
-    rate: float = PARAMETERS["rate"][0]
-    key_timeout: float = PARAMETERS["key_timeout"][0]
-    repeat_timeout: float = PARAMETERS["repeat_timeout"][0]
-    stop_repeats: int = PARAMETERS["stop_repeats"][0]
+    Built directly or by :meth:`from_params`; both check every value (`SettingsError` naming the key).
+    """
+
+    topic: str = param(
+        "jog_arm_server/delta_jog_cmds", nonempty=True,
+        doc="geometry_msgs/TwistStamped output (relative name)",
+    )
+    frame_id: str = param(
+        "", doc="`header.frame_id` of the twists (empty, like the original: the receiver's command frame)"
+    )
+    key_event_topic: str = param(
+        "keyboard_publisher/key_event", nonempty=True, doc="keyboard_publisher/KeyEvent output"
+    )
+    linear_speed: float = param(
+        0.2, unit="m/s", gt=0.0, shown_range=_speed_range("max_linear_speed"),
+        doc="initial linear speed (the original's fixed value)",
+    )
+    max_linear_speed: float = param(0.5, unit="m/s", gt=0.0, doc="upper bound of the linear speed keys")
+    angular_speed: float = param(
+        0.3, unit="rad/s", gt=0.0, shown_range=_speed_range("max_angular_speed"), doc="initial angular speed"
+    )
+    max_angular_speed: float = param(1.0, unit="rad/s", gt=0.0, doc="upper bound of the angular speed keys")
+    speed_step: float = param(
+        1.1, gt=1.0, doc="factor one speed key press multiplies or divides the speed by"
+    )
+    rate: float = param(50.0, unit="Hz", gt=0.0, le=1000.0, doc="publish rate while moving")
+    key_timeout: float = param(
+        0.6, unit="s", gt=0.0,
+        doc="deadman: zero when no motion key came for this long (must exceed the keyboard's repeat delay, "
+        f"else holding a key stutters: a warning at or below {TYPICAL_REPEAT_DELAY} s)",
+    )
+    repeat_timeout: float = param(
+        0.15, unit="s", gt=0.0, shown_range="> 0, <= `~key_timeout`",
+        doc="deadman once the key auto-repeats (a few repeat periods, ~33 ms each)",
+    )
+    stop_repeats: int = param(3, ge=1, doc="zero twists sent after a stop or a timeout, then silence")
 
     def __post_init__(self) -> None:
-        for name in ("topic", "key_event_topic"):
-            value = getattr(self, name)
-            if not isinstance(value, str) or not value:
-                raise SettingsError(name, f"must be a non-empty topic name, got {value!r}")
-        if not isinstance(self.frame_id, str):
-            raise SettingsError("frame_id", f"must be a string, got {self.frame_id!r}")
-        for name in (
-            "linear_speed", "max_linear_speed", "angular_speed", "max_angular_speed", "rate", "key_timeout",
-            "repeat_timeout",
-        ):
-            _positive(name, getattr(self, name))
+        try:
+            PARAMETERS.check(PARAMETERS.values_of(self))
+        except SchemaError as err:
+            raise SettingsError(err.key, err.message) from None
         if self.repeat_timeout > self.key_timeout:
             raise SettingsError(
                 "repeat_timeout", f"{self.repeat_timeout} s exceeds ~key_timeout ({self.key_timeout} s)"
             )
-        _positive("speed_step", self.speed_step)
-        if not self.speed_step > 1.0:
-            raise SettingsError("speed_step", f"must be > 1 (a factor), got {self.speed_step}")
-        if self.rate > 1000.0:
-            raise SettingsError("rate", f"must be at most 1000 Hz, got {self.rate}")
         for speed, limit in (("linear_speed", "max_linear_speed"), ("angular_speed", "max_angular_speed")):
             value, top = getattr(self, speed), getattr(self, limit)
             if not MIN_SPEED_FRACTION * top <= value <= top:
                 raise SettingsError(
                     speed, f"{value} is outside [{MIN_SPEED_FRACTION * top:g}, {top:g}] (~{limit} = {top:g})"
                 )
-        repeats = self.stop_repeats
-        if isinstance(repeats, bool) or not isinstance(repeats, int) or repeats < 1:
-            raise SettingsError("stop_repeats", f"must be an integer >= 1, got {self.stop_repeats!r}")
 
     @classmethod
     def from_params(cls, params: Mapping[str, Any]) -> tuple[TeleopSettings, list[str]]:
@@ -129,19 +125,12 @@ class TeleopSettings:
         Raises:
             SettingsError: an unknown key (naming the closest valid one), a wrong type or range.
         """
-        known = {f.name for f in fields(cls)}
-        for key in sorted(params):
-            if key not in known:
-                raise SettingsError(key, unknown_key_message(key, known, "~"))
+        try:
+            values = PARAMETERS.load(params, prefix="~")
+        except SchemaError as err:
+            raise SettingsError(err.key, err.message) from None
+        settings = cls(**PARAMETERS.attrs(values))
         warnings: list[str] = []
-        values: dict[str, Any] = {}
-        for key in known & set(params):
-            value = params[key]
-            default = PARAMETERS[key][0]
-            if isinstance(default, float) and isinstance(value, int) and not isinstance(value, bool):
-                value = float(value)
-            values[key] = value
-        settings = cls(**values)
         if settings.key_timeout <= TYPICAL_REPEAT_DELAY:
             warnings.append(
                 f"~key_timeout {settings.key_timeout} s is not above the usual keyboard repeat delay "
@@ -150,10 +139,7 @@ class TeleopSettings:
         return settings, warnings
 
 
-def _positive(name: str, value: Any) -> None:
-    number = isinstance(value, int | float) and not isinstance(value, bool)
-    if not number or not math.isfinite(value) or value <= 0:
-        raise SettingsError(name, f"must be a finite number > 0, got {value!r}")
+PARAMETERS = schema_of(TeleopSettings)
 
 
 class KeyResult(NamedTuple):

@@ -12,22 +12,20 @@ __all__ = ["create_widget", "main"]
 def create_widget(parent=None):
     """Builds the panel from the node's private parameters (rospy must be initialised).
 
-    Parameters (all private): `~config` (path of the form YAML; default the package's config/gui.yaml),
-    `~contact_control_node`, `~configure_service`, `~tare_service`, `~stop_service`, `~reset_service`,
-    `~status_topic` (see README), `~retry_period` [s].
+    Parameters: `manipulator_control_gui.params` (all private; see README). An unknown key or a bad value
+    raises ValueError naming it.
     """
     import rospy
 
     from manipulator_control_gui.form_config import load_config
+    from manipulator_control_gui.params import load_settings
     from manipulator_control_gui.ros_client import RosNames
     from manipulator_control_gui.widget import ControlWidget
 
-    config = load_config(rospy.get_param("~config", "") or None)
-    names = RosNames.from_params(rospy.get_param)
-    retry = float(rospy.get_param("~retry_period", 1.0))
-    if retry <= 0.0:
-        raise ValueError(f"parameter '~retry_period' must be > 0 s, got {retry}")
-    return ControlWidget(config, names, retry_period=retry, parent=parent)
+    settings = load_settings(rospy.get_param("~", {}))
+    config = load_config(settings.config or None)
+    names = RosNames.from_settings(settings)
+    return ControlWidget(config, names, retry_period=settings.retry_period, parent=parent)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -11,40 +11,56 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from manipulator_control_gui.params import PARAMETERS, GuiSettings, load_settings
+
 __all__ = ["Availability", "CallResult", "ContactControlClient", "RosNames"]
+
+
+_NODE = GuiSettings.contact_control_node  # the declared default
 
 
 @dataclass(frozen=True)
 class RosNames:
-    """Where contact_control is. Relative names resolve in the GUI node's namespace."""
+    """Where contact_control is. Relative names resolve in the GUI node's namespace.
 
-    configure_service: str = "configure_cartesian_impedance"
-    tare_service: str = "contact_control_node/tare"
-    stop_service: str = "contact_control_node/stop"
-    reset_service: str = "contact_control_node/reset"
-    status_topic: str = "contact_control_node/status"
+    The defaults are those of the parameter defaults (`manipulator_control_gui.params`).
+    """
+
+    configure_service: str = GuiSettings.configure_service
+    tare_service: str = f"{_NODE}/tare"
+    stop_service: str = f"{_NODE}/stop"
+    reset_service: str = f"{_NODE}/reset"
+    status_topic: str = f"{_NODE}/status"
     #: compliant_control_msgs/ConfigureLaws, used instead of configure_service when registered (it answers
     #: with the reason of a refusal).
     laws_service: str = "configure_laws"
 
     @classmethod
-    def from_params(cls, get_param: Callable[[str, Any], Any]) -> RosNames:
-        """Reads `~contact_control_node` (namespace of the node's private names) and per-name overrides.
-
-        `~configure_laws_service` defaults to `configure_laws` beside `~configure_service` (same namespace).
-        """
-        node = str(get_param("~contact_control_node", "contact_control_node")).rstrip("/")
-        configure = str(get_param("~configure_service", cls.configure_service))
-        namespace, slash, _ = configure.rpartition("/")
-        laws = f"{namespace}{slash}{cls.laws_service}"
+    def from_settings(cls, settings: GuiSettings) -> RosNames:
+        """The names from the panel's parameters: `contact_control_node` (namespace of the node's private
+        names) and per-name overrides; `configure_laws_service` defaults to `configure_laws` beside
+        `configure_service` (same namespace)."""
+        node = settings.contact_control_node.rstrip("/")
+        namespace, slash, _ = settings.configure_service.rpartition("/")
         return cls(
-            configure_service=configure,
-            tare_service=str(get_param("~tare_service", f"{node}/tare")),
-            stop_service=str(get_param("~stop_service", f"{node}/stop")),
-            reset_service=str(get_param("~reset_service", f"{node}/reset")),
-            status_topic=str(get_param("~status_topic", f"{node}/status")),
-            laws_service=str(get_param("~configure_laws_service", laws)),
+            configure_service=settings.configure_service,
+            tare_service=settings.tare_service or f"{node}/tare",
+            stop_service=settings.stop_service or f"{node}/stop",
+            reset_service=settings.reset_service or f"{node}/reset",
+            status_topic=settings.status_topic or f"{node}/status",
+            laws_service=settings.configure_laws_service or f"{namespace}{slash}{cls.laws_service}",
         )
+
+    @classmethod
+    def from_params(cls, get_param: Callable[[str, Any], Any]) -> RosNames:
+        """Like :meth:`from_settings`, reading each name parameter with `get_param("~<key>", default)`.
+
+        Raises:
+            ValueError: A value of the wrong type, naming the key.
+        """
+        names = [key for key in PARAMETERS if key not in ("config", "retry_period")]
+        return cls.from_settings(load_settings({key: get_param(f"~{key}", PARAMETERS[key].default)
+                                                for key in names}))
 
 
 @dataclass(frozen=True)

@@ -565,10 +565,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         params = rospy.get_param("~", {})
         use_sim_time = bool(rospy.get_param("/use_sim_time", False))
-        settings = DriverSettings.from_params(params, use_sim_time=use_sim_time)
-        for key in DriverSettings.unknown_keys(params):
-            if key != "robot_description":
-                rospy.logwarn("mujoco_driver: ~%s is not a driver parameter, ignored", key)
+        settings = DriverSettings.from_params(params, use_sim_time=use_sim_time)  # unknown keys refused
         # ~robot_description (the simulated robot itself, as an emulated driver has it) wins over the shared
         # robot_description, which the user's own launch file may load, as on a real cell.
         key = "~robot_description" if rospy.has_param("~robot_description") else "robot_description"

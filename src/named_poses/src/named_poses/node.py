@@ -19,6 +19,7 @@ from compliant_control_msgs.srv import MoveToNamedPose, MoveToNamedPoseResponse
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
+from named_poses.params import FILE_KEYS, load_settings
 from named_poses.poses import NamedPoses, PoseError, urdf_joints
 from named_poses.profile import ProfileError, plan_move
 
@@ -30,7 +31,12 @@ class NamedPoseServer:
 
     def __init__(self) -> None:
         urdf = rospy.get_param("robot_description")
-        config = rospy.get_param("~config", "")
+        params = rospy.get_param("~", {})
+        try:
+            settings = load_settings(params)
+        except ValueError as exc:
+            raise PoseError(str(exc)) from None
+        config = settings.config
         if config:  # the file itself: a dict loaded onto the parameter server merges with a previous robot's
             try:
                 with open(config, encoding="utf-8") as handle:
@@ -38,22 +44,21 @@ class NamedPoseServer:
             except (OSError, yaml.YAMLError) as exc:
                 raise PoseError(f"~config: cannot read {config}: {exc}") from exc
         else:
-            data = {key: rospy.get_param(f"~{key}") for key in ("poses", "max_velocity", "max_acceleration")
-                    if rospy.has_param(f"~{key}")}
+            data = {key: params[key] for key in FILE_KEYS if key in params}
         self.poses = NamedPoses.from_dict(data, urdf_joints(urdf))
-        self.tolerance = float(rospy.get_param("~goal_tolerance", 0.01))  # [rad]
-        self.settle_time = float(rospy.get_param("~settle_time", 3.0))  # [s] after the planned end
+        self.tolerance = settings.goal_tolerance  # [rad]
+        self.settle_time = settings.settle_time  # [s] after the planned end
         self._lock = threading.Lock()
         self._busy = threading.Lock()
         self._positions: dict[str, float] = {}
         self._status: ContactControlStatus | None = None
         self._pub = rospy.Publisher(
-            rospy.get_param("~trajectory_topic", "arm_controller/command"), JointTrajectory, queue_size=1,
+            settings.trajectory_topic, JointTrajectory, queue_size=1,
             tcp_nodelay=True,
         )
-        rospy.Subscriber(rospy.get_param("~joint_states_topic", "joint_states"), JointState, self._on_joints,
+        rospy.Subscriber(settings.joint_states_topic, JointState, self._on_joints,
                          queue_size=1, tcp_nodelay=True)
-        rospy.Subscriber(rospy.get_param("~contact_control_status", "/contact_control_node/status"),
+        rospy.Subscriber(settings.contact_control_status,
                          ContactControlStatus, self._on_status, queue_size=1)
         rospy.Service("~move_to", MoveToNamedPose, self._move_to)
         rospy.loginfo(

@@ -1,8 +1,9 @@
 """A robot package's named poses (`config/named_poses.yaml`) checked against its URDF.
 
-Pure: standard library and numpy. A pose names every arm joint's angle [rad]; limits are joint-space
-velocity and acceleration, one number for all joints or one per joint, capped by the URDF's velocity
-limits. Continuous joints go to the nearest equivalent angle (whole turns are not undone).
+Pure: standard library, numpy and the parameter declarations (`named_poses.params`). A pose names every
+arm joint's angle [rad]; limits are joint-space velocity and acceleration, one number for all joints or one
+per joint, capped by the URDF's velocity limits. Continuous joints go to the nearest equivalent angle
+(whole turns are not undone).
 """
 
 from __future__ import annotations
@@ -15,7 +16,12 @@ from typing import Any
 
 import numpy as np
 
+from named_poses.params import FILE_KEYS, NamedPoseSettings
+
 __all__ = ["NamedPoses", "PoseError", "UrdfJoint", "urdf_joints"]
+
+
+_DEFAULTS = NamedPoseSettings()
 
 
 class PoseError(ValueError):
@@ -111,9 +117,9 @@ class NamedPoses:
         """
         if not isinstance(data, Mapping):
             raise PoseError(f"named poses must be a mapping, got {type(data).__name__}")
-        unknown = set(data) - {"poses", "max_velocity", "max_acceleration"}
+        unknown = set(data) - set(FILE_KEYS)
         if unknown:
-            raise PoseError(f"unknown keys {sorted(unknown)}; known: poses, max_velocity, max_acceleration")
+            raise PoseError(f"unknown keys {sorted(unknown)}; known: {', '.join(FILE_KEYS)}")
         poses = data.get("poses")
         if not isinstance(poses, Mapping) or not poses:
             raise PoseError("poses: expected a mapping name -> {joint: angle [rad]} with at least one pose")
@@ -143,9 +149,11 @@ class NamedPoses:
                     )
                 values.append(angle)
             arrays[str(name)] = np.array(values)
-        velocity = _per_joint(data.get("max_velocity", 0.5), "max_velocity", joints)
+        velocity = _per_joint(data.get("max_velocity", _DEFAULTS.max_velocity), "max_velocity", joints)
         velocity = np.minimum(velocity, [urdf[j].velocity for j in joints])
-        acceleration = _per_joint(data.get("max_acceleration", 1.0), "max_acceleration", joints)
+        acceleration = _per_joint(
+            data.get("max_acceleration", _DEFAULTS.max_acceleration), "max_acceleration", joints
+        )
         return cls(joints, arrays, velocity, acceleration, tuple(urdf[j].continuous for j in joints))
 
     def goal(self, name: str, current: Sequence[float] | np.ndarray) -> np.ndarray:

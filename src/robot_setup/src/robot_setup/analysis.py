@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 from jog_arm.kinematics import ArmModel
+from jog_arm.settings import JogSettings
 
 __all__ = [
     "DOWN",
@@ -38,7 +39,7 @@ __all__ = [
 
 # Tool pointing down: sensor x = +X, y = -Y, z = -Z of the base frame (the hand-written start poses).
 DOWN = np.diag([1.0, -1.0, -1.0])
-LENGTH_SCALE = 0.4  # [m] jog_arm's singularity_length_scale default
+LENGTH_SCALE = JogSettings.singularity_length_scale  # [m] jog_arm's default
 IK_TOLERANCE = 1e-6  # [m, rad] a pose counts as reached below this error
 PATH_STEPS = 20
 # A start pose is refused closer than this to a joint limit anywhere on the demos' motions [rad].

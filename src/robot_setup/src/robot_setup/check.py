@@ -4,7 +4,8 @@ Pure (no ROS master): reads the package's files, builds the description like mak
 every problem found:
   * frames the YAML files name (scene links, jog_arm's and contact_control's frames) missing from the
     description;
-  * the tool's mass and centre of mass differing between description.args and contact_control.yaml;
+  * the tool's mass and centre of mass differing between description.args and contact_control.yaml (and
+    contact_control_hardware.yaml, unless it leaves the payload to the vendor driver: tool_mass 0);
   * the start pose outside or near (< 0.15 rad) its joint limits, a joint origin under the table, the arm
     touching itself or the table (MuJoCo's collision check on the simulated scene);
   * the demonstrations' motions (config/demos.yaml) unreachable from the start pose, slowed by jog_arm's
@@ -20,11 +21,14 @@ import math
 import os
 import shlex
 import sys
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import yaml
+from contact_control.params import ContactControlSettings
 from jog_arm.kinematics import ArmModel, KinematicsError
+from jog_arm.settings import JogSettings
 from mujoco_driver.description import (
     DescriptionError,
     ToolSpec,
@@ -45,12 +49,22 @@ from thesis_demos.geometry import (
 from robot_setup.analysis import LENGTH_SCALE, MIN_JOINT_HEIGHT, MIN_MARGIN, analyse_pose, lowest_joint
 from robot_setup.collisions import CollisionChecker
 
-__all__ = ["DEMOS", "check_package", "main", "print_report", "problems_by_demo"]
+__all__ = [
+    "DEMOS",
+    "check_package",
+    "main",
+    "print_report",
+    "problems_by_demo",
+    "read_description_args",
+    "tool_payload_problems",
+    "tool_spec",
+]
 
 DEMOS = ("follower_z", "compliant_move_z", "spring_x", "hybrid")
 
 # jog_arm's own defaults (src/jog_arm/config/jog_arm.yaml is loaded under the robot's file).
-_JOG_DEFAULTS = {"singularity_threshold": 7.0, "hard_stop_singularity_threshold": 12.0,
+_JOG_DEFAULTS = {"singularity_threshold": JogSettings.singularity_threshold,
+                 "hard_stop_singularity_threshold": JogSettings.hard_stop_singularity_threshold,
                  "singularity_length_scale": LENGTH_SCALE}
 
 
@@ -59,18 +73,63 @@ def _yaml(path: str) -> dict:
         return yaml.safe_load(handle) or {}
 
 
-def _description(args_path: str) -> tuple[str, argparse.Namespace]:
+def read_description_args(args_path: str) -> argparse.Namespace:
+    """The make_description arguments of a robot package's `config/description.args` (comments allowed).
+
+    Raises:
+        OSError: The file cannot be read.
+        SystemExit: An argument make_description refuses.
+    """
     with open(args_path, encoding="utf-8") as handle:
         words = [w for line in handle for w in shlex.split(line, comments=True)]
-    args = _parser().parse_args(words)
-    erd = find_example_robot_data() if args.source.startswith("example-robot-data:") else None
-    tool = ToolSpec(
+    return _parser().parse_args(words)
+
+
+def tool_spec(args: argparse.Namespace) -> ToolSpec | None:
+    """The tool make_description adds for these arguments (None: no tool)."""
+    if not args.tool_parent:
+        return None
+    return ToolSpec(
         parent=args.tool_parent, ft_name=args.ft_name, ft_xyz=tuple(args.ft_xyz), ft_rpy=tuple(args.ft_rpy),
         name=args.tool_name, mass=args.tool_mass, com=tuple(args.tool_com) if args.tool_com else None,
         inertia=tuple(args.tool_inertia) if args.tool_inertia else None, shape=args.tool_shape,
         size=tuple(args.tool_size), tip_name=args.tip_name,
-    ) if args.tool_parent else None
-    urdf = build_description(read_source(args.source, erd), tool, args.remove_link, erd, args.robot_name)
+    )
+
+
+def tool_payload_problems(
+    tool: ToolSpec | None, cc: Mapping[str, Any], where: str = "contact_control.yaml"
+) -> list[str]:
+    """Where contact_control's `tool_mass` / `tool_com` (the YAML `cc`, contact_control's defaults for absent
+    keys) differ from the tool the description carries: gravity compensation would leave a force.
+
+    The description (description.args) is the source; the YAML must repeat it.
+    """
+    if tool is None:
+        return []
+    problems = []
+    cc_mass = cc.get("tool_mass", ContactControlSettings.tool_mass)
+    cc_com = cc.get("tool_com", ContactControlSettings.tool_com)
+    if not math.isclose(float(cc_mass), tool.mass, abs_tol=1e-9):
+        problems.append(
+            f"tool mass: description.args --tool-mass {tool.mass} kg, {where} "
+            f"tool_mass {cc_mass} kg: gravity compensation would leave "
+            f"{abs(tool.mass - float(cc_mass)) * 9.81:.2f} N"
+        )
+    desc_com = list(tool.com if tool.com is not None else tool.centre())
+    if not np.allclose(desc_com, cc_com, atol=1e-6):
+        problems.append(
+            f"tool centre of mass: description.args --tool-com {desc_com} m, {where} "
+            f"tool_com {list(cc_com)} m"
+        )
+    return problems
+
+
+def _description(args_path: str) -> tuple[str, argparse.Namespace]:
+    args = read_description_args(args_path)
+    erd = find_example_robot_data() if args.source.startswith("example-robot-data:") else None
+    urdf = build_description(read_source(args.source, erd), tool_spec(args), args.remove_link, erd,
+                             args.robot_name)
     return urdf, args
 
 
@@ -109,26 +168,14 @@ def check_package(root: str) -> list[str]:
             problems.append(f"{where}: not set")
         elif not full.existFrame(frame):
             problems.append(f"{where}: frame {frame!r} is not in the description (description.args)")
-    # Tool: what the description carries must be what contact_control subtracts.
-    cc_mass, cc_com = cc.get("tool_mass", 0.0), cc.get("tool_com", [0.0, 0.0, 0.0])
-    if args.tool_parent:
-        if not math.isclose(float(cc_mass), args.tool_mass, abs_tol=1e-9):
-            problems.append(
-                f"tool mass: description.args --tool-mass {args.tool_mass} kg, contact_control.yaml "
-                f"tool_mass {cc_mass} kg: gravity compensation would leave "
-                f"{abs(args.tool_mass - float(cc_mass)) * 9.81:.2f} N"
-            )
-        desc_com = list(args.tool_com) if args.tool_com else None
-        if desc_com is None:
-            spec_len = args.tool_size[1] if args.tool_shape == "cylinder" else (
-                args.tool_size[2] if args.tool_shape == "box" else 2 * args.tool_size[0])
-            desc_com = [0.0, 0.0, spec_len / 2.0]
-        if not np.allclose(desc_com, cc_com, atol=1e-6):
-            problems.append(
-                f"tool centre of mass: description.args --tool-com {desc_com} m, contact_control.yaml "
-                "tool_com "
-                f"{list(cc_com)} m"
-            )
+    # Tool: what the description carries must be what contact_control subtracts (on a real arm too, unless
+    # the hardware config leaves the payload to the vendor driver: tool_mass 0).
+    problems += tool_payload_problems(tool_spec(args), cc)
+    hardware = os.path.join(cfg, "contact_control_hardware.yaml")
+    if os.path.exists(hardware):
+        cc_hw = _yaml(hardware)
+        if float(cc_hw.get("tool_mass", ContactControlSettings.tool_mass)) != 0.0:
+            problems += tool_payload_problems(tool_spec(args), cc_hw, "contact_control_hardware.yaml")
     # Start pose, margins, the demos' motions.
     tip = jog.get("ee_frame_name", "tool_tip")
     try:

@@ -25,6 +25,7 @@ from compliant_control_msgs.srv import (
     PushEEF,
     PushEEFRequest,
 )
+from contact_control.params import ContactControlSettings
 from geometry_msgs.msg import PoseStamped, WrenchStamped
 from std_srvs.srv import Trigger
 
@@ -155,7 +156,9 @@ class DemoRunner:
         except rospy.ROSException:
             rospy.logwarn("thesis_demos: no %s/move_to: the driver's ~reset brings the arm to its start pose",
                           names.named_poses)
-        self._base_frame = names.base_frame or rospy.get_param(f"{cc}/fixed_frame", "base_link")
+        self._base_frame = names.base_frame or rospy.get_param(
+            f"{cc}/fixed_frame", ContactControlSettings.fixed_frame
+        )
         self._tf = tf2_ros.Buffer()
         self._tf_listener = tf2_ros.TransformListener(self._tf)
         self._pose = _Series(3)

@@ -1,0 +1,72 @@
+"""The named_pose_server's private parameters, each declared once (no ROS): `PARAMETERS` validates them at
+start-up and generates the README's table.
+
+Without `~config`, `poses`, `max_velocity` and `max_acceleration` are the node's private parameters, with
+them the keys of the file; `poses.NamedPoses.from_dict` checks them against the URDF (these defaults apply).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from compliant_common.schema import SchemaError, param, schema_of
+
+__all__ = ["FILE_KEYS", "PARAMETERS", "NamedPoseSettings", "load_settings"]
+
+#: The keys of a robot package's named_poses.yaml (also private parameters when `~config` is empty).
+FILE_KEYS = ("poses", "max_velocity", "max_acceleration")
+
+
+@dataclass(frozen=True)
+class NamedPoseSettings:
+    """The node's parameters (name, type, default, unit, range, doc declared here)."""
+
+    config: str = param(
+        "",
+        doc="path of the robot package's `named_poses.yaml` (`poses`, `max_velocity`, `max_acceleration`), "
+        "read by the node itself: loaded as parameters, a dict would merge with the poses a previous robot "
+        "left on the same master. Empty: the same keys as private parameters",
+    )
+    poses: Mapping[str, Any] | None = param(
+        None, type="mapping", optional=True, unit="rad",
+        doc="name -> {joint: angle}; every pose names the same joints, each within its URDF limits",
+    )
+    max_velocity: Any = param(
+        0.5, type="any", unit="rad/s", shown_range="> 0, one number or {joint: value}",
+        doc="joint-space velocity limit of a move (capped by the URDF's)",
+    )
+    max_acceleration: Any = param(
+        1.0, type="any", unit="rad/s^2", shown_range="> 0, one number or {joint: value}",
+        doc="joint-space acceleration limit of a move",
+    )
+    goal_tolerance: float = param(
+        0.01, unit="rad", gt=0.0, doc="`~move_to` succeeds once every joint is this close to the pose"
+    )
+    settle_time: float = param(
+        3.0, unit="s", ge=0.0, doc="`~move_to` fails this long after the planned end if not arrived"
+    )
+    trajectory_topic: str = param(
+        "arm_controller/command", nonempty=True, doc="trajectory_msgs/JointTrajectory output (the driver's)"
+    )
+    joint_states_topic: str = param("joint_states", nonempty=True, doc="sensor_msgs/JointState input")
+    contact_control_status: str = param(
+        "/contact_control_node/status", nonempty=True,
+        doc="compliant_control_msgs/ContactControlStatus input: no move while a contact move runs",
+    )
+
+
+PARAMETERS = schema_of(NamedPoseSettings)
+
+
+def load_settings(params: Mapping[str, Any]) -> NamedPoseSettings:
+    """Settings from the node's private parameters (`rospy.get_param("~")`).
+
+    Raises:
+        ValueError: An unknown key (naming the closest valid one) or a bad value, naming the key.
+    """
+    try:
+        return NamedPoseSettings(**PARAMETERS.attrs(PARAMETERS.load(params, prefix="~")))
+    except SchemaError as err:
+        raise ValueError(err.message if err.message.startswith(f"~{err.key} ") else f"~{err}") from None
