@@ -193,3 +193,33 @@ def test_the_core_imports_no_rospy(module: str) -> None:
             "print(bad); sys.exit(1 if bad else 0)")
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert run.returncode == 0, f"{module} imports {run.stdout or run.stderr}"
+
+
+def test_requests_are_answered_with_the_reason_and_a_stop_halts_the_arm(cell: Cell) -> None:
+    from cartesian_impedance_msgs.msg import ControlLaw
+    from cartesian_impedance_msgs.srv import ConfigureForceControlRequest
+
+    p = cell.pipeline
+    bad = ConfigureForceControlRequest()
+    bad.direction_control_laws.z.type = ControlLaw.TYPE_FOLLOWER  # no damping: refused
+    answer = p.configure(bad, cell.t)
+    assert not answer.ok and "damping" in answer.message
+    assert not p.contact.ctrl.move_active, "a refused request changed something"
+    good = ConfigureForceControlRequest()
+    good.cart_impedance_params.damping.translational.z = DAMPING
+    good.direction_control_laws.z.type = ControlLaw.TYPE_FOLLOWER
+    answer = p.configure(good, cell.t)
+    assert answer.ok and "z=follower" in answer.message, answer
+    for _ in range(200):
+        cell.step((0.0, 0.0, 4.0))
+    status = p.status()
+    assert status.contact.move_active
+    assert status.jog is not None and status.jog.status == StatusCode.NO_WARNING
+    out = p.stop("test", cell.t)
+    assert out.twist == (0.0,) * 6 and out.cycle is not None
+    assert not p.contact.ctrl.move_active
+    cell.step((0.0, 0.0, 4.0))
+    assert not p.status().contact.move_active  # the status shows the last cycle
+    for _ in range(200):  # the push goes on; the stopped move does not follow it
+        cell.step((0.0, 0.0, 4.0))
+    assert cell.commands[-1][1] == (0.0,) * len(cell.names)

@@ -17,16 +17,26 @@ from __future__ import annotations
 import collections
 import time
 from collections.abc import Callable, Sequence
+from typing import Any, NamedTuple
 
 from compliant_common.clock import ClockWatch
+from contact_control.controller import CycleResult
 from contact_control.params import ContactControlSettings
-from contact_control.stage import ZERO, ContactStage, PoseSource, Velocity
+from contact_control.stage import ZERO, Answer, ContactStage, PoseSource, Velocity
 from jog_arm.settings import JogSettings
 from jog_arm.stage import JogCycle, JogStage
 
-__all__ = ["CompliantPipeline", "PipelineOutput"]
+__all__ = ["CompliantPipeline", "PipelineOutput", "PipelineStatus"]
 
 ECHOES_KEPT = 16  # own twists remembered to recognise their copies coming back over the topic
+
+
+class PipelineStatus(NamedTuple):
+    """What `CompliantPipeline.status` reports."""
+
+    contact: CycleResult
+    contact_message: str
+    jog: JogCycle | None
 
 
 class PipelineOutput:
@@ -184,6 +194,22 @@ class CompliantPipeline:
             self._sent.clear()
             self._to_jog(self.contact.clock_jumped(note, t) or ZERO, t, out)
         return out
+
+    # --- requests and status ---
+    def configure(self, request: Any, t: float, per_axis: bool = False) -> Answer:
+        """A ConfigureForceControl (or, `per_axis`, a ConfigureLaws) request: (ok, code, message, move_id),
+        the laws in words or the reason for refusing. Nothing changes when it is refused."""
+        return self.contact.configure(request, t, per_axis)
+
+    def stop(self, reason: str, t: float) -> PipelineOutput:
+        """Ends the running move; the zero twist goes to jog_arm at once."""
+        return self.from_contact(self.contact.stop(reason), t)
+
+    def status(self) -> PipelineStatus:
+        """Both stages' state for the status topics: contact_control's last cycle and message, jog_arm's
+        last cycle (None before the first)."""
+        result, message = self.contact.status()
+        return PipelineStatus(result, message, self.jog.last_cycle)
 
     # --- master ---
     def master_lost(self, reason: str) -> PipelineOutput:

@@ -93,6 +93,7 @@ class JogStage:
         self._period = s.pub_period
         self._points = s.simu_points if s.simu else 1
         self._cycle = JogCycle()
+        self._cycled = False
         self._last_status = StatusCode.NO_JOINT_STATE
         self._cycles = CycleMonitor(s.pub_period)
         self._next_missed_warning = -math.inf
@@ -222,6 +223,7 @@ class JogStage:
             self.notes.append(("warn", f"{self._cycles.missed} publish cycles missed so far (longest gap "
                                f"{self._cycles.max_gap * 1e3:.1f} ms, period {self._period * 1e3:g} ms)"))
         out: JogOutput = self.jog.step(t)
+        self._cycled = True
         c = self._cycle
         c.t = t
         c.publish = out.publish
@@ -243,6 +245,11 @@ class JogStage:
         c.status_changed = status != self._last_status
         self._last_status = status
         return c
+
+    @property
+    def last_cycle(self) -> JogCycle | None:
+        """The last cycle's output (None before the first)."""
+        return self._cycle if self._cycled else None
 
     def prepare(self) -> None:
         """The next cycle's twist-independent work (Jacobian, factorisation) now: call it after publishing,
