@@ -100,14 +100,14 @@ class ContactControlSettings:
         True, doc="design the filter for the measured sample period (`lp_filter_delta_t` until known)"
     )
     ft_x_direction: int = _sign(
-        "legacy sign flip of sensor force X and torque X (original Panda: -1; prefer correct tf frames)"
+        "legacy sign flip of sensor force X and torque X (the original used -1 for one arm; prefer correct tf frames)"
     )
     ft_y_direction: int = _sign("legacy sign flip of sensor force Y and torque Y")
     ft_z_direction: int = _sign("legacy sign flip of sensor force Z and torque Z")
     travel_x_direction: int = _sign("legacy sign flip of the measured travel along X and about X")
     travel_y_direction: int = _sign("legacy sign flip of the measured travel along Y and about Y")
     travel_z_direction: int = _sign(
-        "legacy sign flip of the measured travel along Z and about Z (original Panda: -1)"
+        "legacy sign flip of the measured travel along Z and about Z (the original used -1 for one arm)"
     )
     tare_on_startup: bool = param(True, doc="tare with the first valid wrench")
     bias: tuple[float, ...] = param(

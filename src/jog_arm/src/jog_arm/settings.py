@@ -106,7 +106,7 @@ class JogSettings:
     )
     incoming_cmd_timeout: float = _pos(
         1.0, "s",
-        "no command this long: stop (UR5 real 1, UR5 sim 5, Panda 0.3 in the fork; the robot packages use "
+        "no command this long: stop (0.3-5 in the fork; the robot packages use "
         "0.1)",
     )
     joint_state_timeout: float = _pos(
