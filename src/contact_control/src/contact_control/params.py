@@ -100,7 +100,7 @@ class ContactControlSettings:
         True, doc="design the filter for the measured sample period (`lp_filter_delta_t` until known)"
     )
     ft_x_direction: int = _sign(
-        "legacy sign flip of sensor force X and torque X (the original used -1 for one arm; prefer correct tf frames)"
+        "legacy sign flip of sensor force X and torque X (the fork used -1 on one arm; prefer correct frames)"
     )
     ft_y_direction: int = _sign("legacy sign flip of sensor force Y and torque Y")
     ft_z_direction: int = _sign("legacy sign flip of sensor force Z and torque Z")
