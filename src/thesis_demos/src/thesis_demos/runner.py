@@ -272,8 +272,10 @@ class DemoRunner:
         self._update_sensor_rotation(sensor_frame)
         for series in (self._pose, self._status, self._wrench):
             series.clear()
-        time.sleep(0.3)  # a baseline of the tared sensor before the laws start (plotted, not timed)
+        # 0.3 s of the tared sensor before the laws start: the recorded contact force's zero (it was the few
+        # ms of the configure call only, which a loaded machine could leave without a wrench).
         baseline_t = rospy.get_time()
+        time.sleep(0.3)
         self._send(scenario, scenario.laws)
         t0 = rospy.get_time()
         pushes = sorted(scenario.pushes, key=lambda p: p.start)
