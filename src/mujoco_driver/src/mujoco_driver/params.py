@@ -30,6 +30,8 @@ class DriverSettings:
         scene_config: Path of the scene YAML ("" when ``scene`` is given).
         scene: The scene settings as a mapping (used when ``scene_config`` is "").
         start_pose: Optional override of the scene's start pose (list in URDF joint order or mapping).
+        timestep: Override of the scene's physics step [s]; 0 = the scene's. With ``publish_period`` 0 the
+            state (wrench, joint_states) goes out every step, so this sets their rate too (1 kHz at 0.001).
         real_time_factor: Simulated seconds per wall-clock second; 0 = as fast as possible.
         publish_clock: Publish rosgraph_msgs/Clock on /clock and stamp everything with simulated time.
         publish_period: Period of joint_states and wrench [s]; 0 = every simulation step.
@@ -57,6 +59,7 @@ class DriverSettings:
     scene_config: str = ""
     scene: Mapping[str, Any] | None = None
     start_pose: Any = None
+    timestep: float = 0.0
     real_time_factor: float = 1.0
     publish_clock: bool = False
     publish_period: float = 0.0
@@ -139,6 +142,8 @@ class DriverSettings:
                 f"~real_time_factor: {self.real_time_factor} runs faster than the wall clock, which needs "
                 "simulated time: set ~publish_clock (or /use_sim_time) true"
             )
+        if not 0.0 <= self.timestep <= 0.01:
+            raise ParamError(f"~timestep: must be in (0, 0.01] s, or 0 for the scene's, got {self.timestep}")
         for key in ("publish_period", "eef_pose_period"):
             if getattr(self, key) < 0.0:
                 raise ParamError(f"~{key}: must be >= 0, got {getattr(self, key)}")
@@ -187,7 +192,8 @@ def urdf_root_link(urdf_xml: str) -> str:
 
 
 def load_scene(settings: DriverSettings) -> SceneConfig:
-    """The scene settings from ``~scene_config`` or ``~scene``, with ``~start_pose`` applied.
+    """The scene settings from ``~scene_config`` or ``~scene``, with ``~start_pose`` and ``~timestep``
+    applied.
 
     Raises:
         ConfigError: On an unreadable file or a bad setting.
@@ -198,4 +204,6 @@ def load_scene(settings: DriverSettings) -> SceneConfig:
         cfg = SceneConfig.from_dict(settings.scene or {})
     if settings.start_pose is not None:
         cfg = dataclasses.replace(cfg, start_pose=PerJoint.parse(settings.start_pose, "~start_pose"))
+    if settings.timestep > 0.0:
+        cfg = dataclasses.replace(cfg, timestep=settings.timestep)
     return cfg
