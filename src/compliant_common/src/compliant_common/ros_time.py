@@ -14,6 +14,9 @@ from compliant_common.clock import ClockJump, ClockWatch
 
 __all__ = ["JumpAwareClock", "MonotonicTimer", "sleep_through_jumps", "timer"]
 
+#: [s] A reading whose ROS clock read is further than this from its monotonic stamp is not judged.
+PAIR_TOLERANCE = 2e-4
+
 
 def sleep_through_jumps(duration: float) -> bool:
     """`rospy.sleep(duration)`; False if the clock jumped back meanwhile (rospy raises then, which ends the
@@ -90,8 +93,19 @@ class JumpAwareClock:
         self._observe = self._watch.observe
 
     def read(self) -> tuple[float, ClockJump | None]:
-        """The ROS time [s], and the jump since the previous reading (by any thread) if there was one."""
+        """The ROS time [s], and the jump since the previous reading (by any thread) if there was one.
+
+        The two clocks are read one after the other; a thread held up between them (preempted, or the GIL
+        passed to another thread that read the clock meanwhile) would pair an old ROS time with a late
+        monotonic stamp, which looked like the clock stepping back by the delay (1-4 ms on a loaded machine:
+        jog_arm then halted "until a fresh joint state"). Such a reading (its monotonic reads more than
+        `PAIR_TOLERANCE` apart) is returned unjudged; the next one is.
+        """
+        before = time.monotonic()
         # rospy.get_time() on the wall clock builds a rospy.Time first (1.9 us, time.time() 0.1 us); this is
         # read several times per control cycle.
         t = time.time() if is_wallclock() else rospy.get_time()
-        return t, self._observe(t, time.monotonic())
+        after = time.monotonic()
+        if after - before > PAIR_TOLERANCE:
+            return t, None
+        return t, self._observe(t, before)
