@@ -1,7 +1,11 @@
 """ClockWatch: which clock readings count as a jump (back, forward) or a stopped clock."""
 
+import types
+
 import pytest
 from compliant_common.clock import ClockWatch
+
+from compliant_common import ros_time
 
 
 def feed(watch: ClockWatch, readings):
@@ -47,3 +51,22 @@ def test_a_stopped_clock_is_reported_once_then_again_after_it_ran_and_stopped_ag
 def test_bad_tolerances_are_refused():
     with pytest.raises(ValueError):
         ClockWatch(forward_tolerance=0.0)
+
+
+def test_jump_aware_clock_does_not_judge_a_reading_held_up_between_its_clocks(monkeypatch):
+    """A thread preempted between reading the ROS clock and the monotonic one must not report a jump back."""
+    readings = iter([
+        10.0000, 100.000, 10.0001,  # monotonic, ROS time, monotonic: a prompt reading
+        10.0020, 100.002, 10.0021,
+        10.0030, 99.9990, 10.0080,  # held up 5 ms between the reads: an old ROS time, not judged
+        10.0090, 100.009, 10.0091,
+        10.0100, 99.0000, 10.0101,  # a real step back by 1 s, read promptly: reported
+    ])
+    fake = types.SimpleNamespace(monotonic=lambda: next(readings), time=lambda: next(readings))
+    monkeypatch.setattr(ros_time, "time", fake)
+    monkeypatch.setattr(ros_time, "is_wallclock", lambda: True)
+    clock = ros_time.JumpAwareClock()
+    results = [clock.read() for _ in range(5)]
+    assert [t for t, _ in results] == [100.000, 100.002, 99.999, 100.009, 99.0]
+    assert [jump is None for _, jump in results] == [True, True, True, True, False]
+    assert results[4][1].backwards

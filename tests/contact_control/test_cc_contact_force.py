@@ -25,3 +25,21 @@ def test_contact_force_is_compensated_and_rotated_but_not_filtered():
     assert result.wrench[2] < 1.0
     assert ctrl.contact_force([float("nan"), 0, 0, 0, 0, 0], T, R) is None
     assert ctrl.contact_force(pressed, T, None) is None  # with a tool model the orientation is needed
+
+
+def test_contact_force_is_the_unfiltered_force_of_the_chain():
+    """Sign flips, bias, tool weight and the frame change as the laws' chain has them (filter off)."""
+    ctrl = controller(
+        tool_mass=0.8, tool_com=[0.01, 0.0, 0.04], lp_filter_enabled=False, ft_x_direction=-1,
+        ft_z_direction=-1,
+    )
+    R = rot([0.3, -0.5, 0.8], 2.1)
+    T = np.eye(4)
+    T[:3, :3] = rot([0.0, 0.0, 1.0], 0.7)
+    T[:3, 3] = [0.1, -0.2, 0.3]
+    ctrl.tare([0.5, -1.0, 2.0, 0.01, 0.02, -0.03], R)
+    raw = [3.0, -4.0, 7.5, 0.2, -0.1, 0.05]
+    code, chain = ctrl.preprocessor.process(raw, T, R)
+    assert code == 0
+    assert ctrl.contact_force(raw, T, R) == pytest.approx(chain[:3], abs=1e-12)
+    assert ctrl.contact_force(np.array(raw), T.tolist(), R.tolist()) == pytest.approx(chain[:3], abs=1e-12)

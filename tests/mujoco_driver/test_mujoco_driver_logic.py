@@ -195,6 +195,8 @@ def test_faster_than_real_time_needs_the_clock():
     ({"scene_config": "x", "wrench_topic": ""}, "wrench_topic"),
     ({"scene_config": "x", "start_pose": 1.0}, "start_pose"),
     ({"scene_config": "x", "real_time_factor": math.nan}, "real_time_factor"),
+    ({"scene_config": "x", "timestep": -0.001}, "timestep"),
+    ({"scene_config": "x", "timestep": 0.02}, "timestep"),
 ])
 def test_bad_parameters_are_refused_naming_the_key(params, key):
     with pytest.raises(ParamError, match=key):
@@ -232,6 +234,17 @@ def test_scene_from_a_mapping_with_the_start_pose_overridden(robot):
     sim.step(10)
     sim.reset()
     np.testing.assert_allclose(sim.qpos, pose)  # ~reset returns to the override
+
+
+def test_timestep_override_sets_the_physics_step_and_so_the_state_rate(robot):
+    scene_file = str(ROOT / "src" / robot.package / "config" / "sim.yaml")
+    assert load_scene(DriverSettings.from_params({"scene_config": scene_file})).timestep == 0.002  # scene's
+    settings = DriverSettings.from_params({"scene_config": scene_file, "timestep": 0.001})
+    sim = Simulation(robot.urdf, load_scene(settings))
+    assert sim.dt == 0.001
+    assert settings.publish_every(sim.dt) == 1  # the state goes out every step: 1 kHz
+    sim.step(1000)
+    assert sim.time == pytest.approx(1.0)
 
 
 def test_bad_scene_inputs_are_refused_naming_the_key(robot, tmp_path):

@@ -45,7 +45,7 @@ from contact_control.axes import (
 from contact_control.exceeded import ExceededReaction
 from contact_control.laws import AxisLaw, ForceWindow, check_end, law_velocity, shape_velocity
 from contact_control.params import ContactControlSettings
-from contact_control.preprocess import PreprocessError, WrenchPreprocessor, is_finite6
+from contact_control.preprocess import PreprocessError, WrenchPreprocessor, as_rows, is_finite6
 from contact_control.rate import SamplePeriod
 from contact_control.request import FAILURE, RequestError
 from contact_control.travel import TravelMeter
@@ -505,21 +505,18 @@ class ContactControl:
         early as possible (jog_arm's contact guard): the low-pass filter of the laws lags it by tens of ms.
         It reads the current bias and tool model and changes nothing (no filter step, no limit check).
         """
-        if len(wrench) != 6 or not is_finite6(wrench):
+        if len(wrench) != 6:
             return None
-        p = self.preprocessor
-        f = [float(wrench[i]) * self.settings.ft_directions[i] for i in range(3)]
-        b = p.bias
-        f = [f[i] - b[i] for i in range(3)]
-        if self.settings.tool_mass > 0.0:
-            if R_world_sensor is None:
-                return None
-            g = p.gravity_wrench(R_world_sensor)
-            f = [f[i] - g[i] for i in range(3)]
-        if T_control_sensor is None:
-            return (f[0], f[1], f[2])
-        r = [[float(T_control_sensor[i][j]) for j in range(3)] for i in range(3)]
-        return tuple(r[i][0] * f[0] + r[i][1] * f[1] + r[i][2] * f[2] for i in range(3))  # type: ignore[return-value]
+        f = self.preprocessor.contact_force(wrench, R_world_sensor)
+        if f is None or T_control_sensor is None:
+            return f
+        r0, r1, r2 = as_rows(T_control_sensor)[:3]
+        fx, fy, fz = f
+        return (
+            r0[0] * fx + r0[1] * fy + r0[2] * fz,
+            r1[0] * fx + r1[1] * fy + r1[2] * fz,
+            r2[0] * fx + r2[1] * fy + r2[2] * fz,
+        )
 
     @property
     def fresh_until(self) -> float:

@@ -154,6 +154,31 @@ class WrenchPreprocessor:
             self._filter.reset()
         return tuple(self._bias)
 
+    def contact_force(
+        self, raw: Sequence[float], R_world_sensor: Any = None
+    ) -> tuple[float, float, float] | None:
+        """The force of a raw wrench with sign flips, bias and the tool's weight taken out, sensor frame [N],
+        unfiltered and unchecked (no state changes); None for a NaN/inf wrench or, with a tool mass, a
+        missing orientation."""
+        fx, fy, fz, tx, ty, tz = raw
+        s = fx + fy + fz + tx + ty + tz
+        if s - s != 0.0:
+            return None
+        if self._flip:
+            sx, sy, sz = self._signs
+            fx, fy, fz = fx * sx, fy * sy, fz * sz
+        b = self._bias
+        fx, fy, fz = float(fx) - b[0], float(fy) - b[1], float(fz) - b[2]
+        if self._mass:
+            if R_world_sensor is None:
+                return None
+            r = as_rows(R_world_sensor)
+            gx, gy, gz = self._mg  # R^T (m g): the weight in the sensor frame
+            fx -= r[0][0] * gx + r[1][0] * gy + r[2][0] * gz
+            fy -= r[0][1] * gx + r[1][1] * gy + r[2][1] * gz
+            fz -= r[0][2] * gx + r[1][2] * gy + r[2][2] * gz
+        return fx, fy, fz
+
     # --- the cycle ---
     def process(
         self, raw: Sequence[float], T_control_sensor: Any = None, R_world_sensor: Any = None

@@ -47,6 +47,11 @@ class DriverSettings:
         None, shown_default="the scene's", unit="rad", shown_range="a list or a mapping",
         doc="override: list in URDF joint order or `{joint: angle}`; `~reset` returns here", type="any",
     )
+    timestep: float = param(
+        0.0, unit="s", ge=0.0, le=0.01, shown_default="the scene's",
+        doc="override of the scene's physics step (0 = the scene's); with `publish_period` 0 it is also the "
+        "state's period (0.001: wrench and `joint_states` at 1 kHz)",
+    )
     real_time_factor: float = param(
         1.0, ge=0.0,
         doc="simulated s per wall s; above 1, or 0 (as fast as possible), only with `publish_clock`",
@@ -196,4 +201,6 @@ def load_scene(settings: DriverSettings) -> SceneConfig:
         cfg = SceneConfig.from_dict(settings.scene or {})
     if settings.start_pose is not None:
         cfg = dataclasses.replace(cfg, start_pose=PerJoint.parse(settings.start_pose, "~start_pose"))
+    if settings.timestep > 0.0:
+        cfg = dataclasses.replace(cfg, timestep=settings.timestep)
     return cfg

@@ -82,11 +82,18 @@ class Simulation:
         self.data = mujoco.MjData(self.model)
         self.joint_names: tuple[str, ...] = tuple(self.scene.joint_names)
         n = len(self.joint_names)
+        self._dt = float(self.model.opt.timestep)
         self._index = {name: i for i, name in enumerate(self.joint_names)}
         sc = self.scene
         parents = self.model.body_parentid
         self._measured = {b for b in range(self.model.nbody) if self._below(b, sc.sensor_body, parents)}
         self._pos_ctrl, self._vel_ctrl, self._ff_ctrl = sc.ctrl_adr, sc.ctrl_adr + 1, sc.ctrl_adr + 2
+        # The servos' controls as a (joint, [position, velocity, torque]) view when the scene lays them out
+        # that way (it does, joint by joint, and the dofs in joint order): strided copies instead of fancy
+        # indexing, ~5 us less per step.
+        regular = (self.model.nu == 3 * n and np.array_equal(sc.ctrl_adr, 3 * np.arange(n))
+                   and np.array_equal(sc.dof_adr, np.arange(n)))
+        self._ctrl3 = self.data.ctrl.reshape(n, 3) if regular else None
         # Preallocated work arrays. _goal is the position command; _q_target/_qd_target the servo setpoint,
         # which moves towards the command no faster than the velocity limits.
         self._goal = np.zeros(n)
@@ -350,6 +357,15 @@ class Simulation:
             mujoco.mj_step1(model, data)
 
     def _write_controls(self) -> None:
+        ctrl3 = self._ctrl3
+        if ctrl3 is not None:
+            ctrl3[:, 0] = self._q_target
+            ctrl3[:, 1] = self._qd_target
+            if self.config.servo.payload_feedforward:
+                mujoco.mj_jacSubtreeCom(self.model, self.data, self._jacp, self.scene.sensor_body)
+                np.dot(self._payload_force, self._jacp, out=self._ff)
+                ctrl3[:, 2] = self._ff[:len(ctrl3)]  # = _ff[dof_adr]: the dofs lead, in joint order
+            return
         ctrl = self.data.ctrl
         ctrl[self._pos_ctrl] = self._q_target
         ctrl[self._vel_ctrl] = self._qd_target
@@ -371,7 +387,7 @@ class Simulation:
         Trajectory mode: the interpolated velocity plus a correction towards the interpolated position
         (linear near the path, never faster than the joint can still brake), acceleration-limited.
         """
-        dt, q_t, qd_t = self.dt, self._q_target, self._qd_target
+        dt, q_t, qd_t = self._dt, self._q_target, self._qd_target
         vel, err = self._qd_desired, self._q_desired
         if self._mode == MODE_TRAJECTORY:
             self._sample_trajectory(self.time + dt, err, vel)  # may end it: then position mode below
