@@ -255,6 +255,8 @@ class ContactControlRos:
 
     # --- status ---
     def _on_status(self, _event: Any) -> None:
+        if self._status_pub.get_num_connections() == 0:  # nobody listening: save the work
+            return
         with self._lock:
             r, message = self._stage.status()
         msg = self._status_msg  # reused: the status timer allocates nothing per cycle

@@ -91,6 +91,10 @@ class CompliantPipeline:
         self._clock = ClockWatch(stop_tolerance=max(0.5, 2.0 * jog.incoming_cmd_timeout))
         self._sent: collections.deque[tuple[float, Velocity]] = collections.deque(maxlen=ECHOES_KEPT)
         self._out = PipelineOutput()
+        s = contact
+        needed = {s.control_frame, s.ft_sensor_frame, s.velocity_command_frame, s.eef_frame} - {self._fixed}
+        # The model frames a wrench will ask for, computed when the joint state arrives (off the wrench path).
+        self._warm = sorted(f for f in needed if self.jog.frames.has(f, self._fixed))
 
     def frames_from_outside(self) -> list[str]:
         """The configured frames the robot model lacks (they need `outside_poses`)."""
@@ -110,7 +114,11 @@ class CompliantPipeline:
     def on_joint_state(self, names: Sequence[str], positions: Sequence[float], t: float) -> PipelineOutput:
         """A joint state received at `t` [s]."""
         out = self._check_clock(t)
-        self.jog.on_joint_state(names, positions, t)
+        if self.jog.on_joint_state(names, positions, t):
+            # The poses the next wrench needs, computed now (the joint state leads the wrench by half a
+            # period in the simulation; the jog stage prepares its Jacobian likewise).
+            for frame in self._warm:
+                self.jog.frames.pose(frame, self._fixed)
         return out
 
     def on_wrench(

@@ -119,9 +119,12 @@ class JogStage:
     def on_joint_state(self, names: Sequence[str], positions: Sequence[float], t: float) -> bool:
         """A JointState's names and positions received at `t` [s]. False if it is not usable (a controlled
         joint missing or not finite); a warning is noted only if it names some of our joints (other robots'
-        and grippers' states are ignored silently)."""
+        and grippers' states are ignored silently). While moving, the next cycle's twist-independent work
+        (Jacobian, factorisation) is done here, off the twist-to-command path."""
         ok = self.jog.set_joint_state_named(names, positions, t)
-        if not ok and self._joint_set.intersection(names):
+        if ok:  # the next cycle's Jacobian now, off the twist-to-command path (integrate_from: measured)
+            self.jog.prefetch()
+        elif self._joint_set.intersection(names):
             self.notes.append(("warn_throttle", "ignoring a joint state that lacks finite positions for "
                                f"{self.joint_names}"))
         return ok
