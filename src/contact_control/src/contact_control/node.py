@@ -31,13 +31,13 @@ class ContactControlNode:
     """A wrench subscriber and a stale-data thread around one `ContactStage`; every call holds `_lock`."""
 
     def __init__(self, settings: ContactControlSettings) -> None:
-        s = self._s = settings
+        s = settings
         self._lock = threading.Lock()
         self._clock = JumpAwareClock()
         tf = TfPoses(s.fixed_frame)
-        if {s.control_frame, s.ft_sensor_frame, s.eef_frame, s.velocity_command_frame} - {s.fixed_frame}:
-            tf.listen()
         self.stage = ContactStage(settings, tf)
+        if self.stage.frames_used:
+            tf.listen()
         self.ros = ContactControlRos(self.stage, self._lock)
         self._sub = rospy.Subscriber(s.ft_in_topic, WrenchStamped, self._on_wrench, queue_size=1,
                                      tcp_nodelay=True)

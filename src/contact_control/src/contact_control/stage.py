@@ -76,6 +76,10 @@ class ContactStage:
         self._poses = poses
         self._monotonic = monotonic
         self._gravity = s.tool_mass > 0.0
+        #: The frames a cycle may look up besides the fixed one.
+        self.frames_used = frozenset(
+            {s.control_frame, s.ft_sensor_frame, s.eef_frame, s.velocity_command_frame} - {s.fixed_frame}
+        )
         self._period = 1.0 / s.control_rate
         self._idle_zeros = 0
         self._was_active = False

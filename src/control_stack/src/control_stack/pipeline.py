@@ -91,16 +91,12 @@ class CompliantPipeline:
         self._clock = ClockWatch(stop_tolerance=max(0.5, 2.0 * jog.incoming_cmd_timeout))
         self._sent: collections.deque[tuple[float, Velocity]] = collections.deque(maxlen=ECHOES_KEPT)
         self._out = PipelineOutput()
-        s = contact
-        needed = {s.control_frame, s.ft_sensor_frame, s.velocity_command_frame, s.eef_frame} - {self._fixed}
         # The model frames a wrench will ask for, computed when the joint state arrives (off the wrench path).
-        self._warm = sorted(f for f in needed if self.jog.frames.has(f, self._fixed))
+        self._warm = sorted(f for f in self.contact.frames_used if self.jog.frames.has(f, self._fixed))
 
     def frames_from_outside(self) -> list[str]:
         """The configured frames the robot model lacks (they need `outside_poses`)."""
-        s = self.contact.settings
-        wanted = {s.control_frame, s.ft_sensor_frame, s.eef_frame, s.velocity_command_frame} - {self._fixed}
-        return sorted(f for f in wanted if not self.jog.frames.has(f, self._fixed))
+        return sorted(f for f in self.contact.frames_used if not self.jog.frames.has(f, self._fixed))
 
     def _pose(self, frame: str) -> list[list[float]]:
         pose = self.jog.frames.pose(frame, self._fixed)

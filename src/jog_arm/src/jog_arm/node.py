@@ -35,7 +35,6 @@ class JogArmNode:
     """
 
     def __init__(self, settings: JogSettings, urdf_xml: str) -> None:
-        self._s = settings
         self._lock = threading.Lock()
         self.stage = JogStage(settings, urdf_xml)
         self.ros = JogArmRos(self.stage, self._lock)

@@ -39,7 +39,6 @@ class JogArmRos:
     def __init__(self, stage: JogStage, lock: threading.Lock, private_ns: str = "~") -> None:
         s = self._s = stage.settings
         self._stage, self._lock = stage, lock
-        self._pub_lock = threading.Lock()  # the twist and timer threads share the command message
         self._tf_buffer: tf2_ros.Buffer | None = None
         self._tf_listener: tf2_ros.TransformListener | None = None
         self._frames_ready: set[str] = set()
@@ -70,8 +69,8 @@ class JogArmRos:
 
     # --- out ---
     def publish(self, cycle: JogCycle | None) -> None:
-        """The cycle's joint command and status (status only while somebody listens); logs status changes
-        and the stage's notes. Called without the lock."""
+        """The cycle's joint command and status (status only while somebody listens); logs status changes.
+        Called with the node's lock held (the cycle and the messages are shared by its threads)."""
         if cycle is None or self.closed:
             return
         if cycle.publish:
@@ -89,18 +88,17 @@ class JogArmRos:
             log("jog_arm_server: %s: %s", cycle.status.name, cycle.message)
 
     def _publish_command(self, cycle: JogCycle) -> None:
-        msg = self._cmd_msg
-        with self._pub_lock:
-            if isinstance(msg, Float64MultiArray):
-                msg.data = cycle.velocities
-            else:
-                # Stamp 0: "start now" for joint_trajectory_controller, whatever the transport delay.
-                duration = rospy.Duration.from_sec
-                msg.points = [
-                    JointTrajectoryPoint(positions=q, velocities=v, time_from_start=duration(t))
-                    for q, v, t in cycle.points
-                ]
-            self._cmd_pub.publish(msg)
+        msg = self._cmd_msg  # shared by the threads that run cycles: the node's lock is held
+        if isinstance(msg, Float64MultiArray):
+            msg.data = cycle.velocities
+        else:
+            # Stamp 0: "start now" for joint_trajectory_controller, whatever the transport delay.
+            duration = rospy.Duration.from_sec
+            msg.points = [
+                JointTrajectoryPoint(positions=q, velocities=v, time_from_start=duration(t))
+                for q, v, t in cycle.points
+            ]
+        self._cmd_pub.publish(msg)
 
     def log_notes(self) -> None:
         """Logs the stage's notes (lock held); "warn_throttle" ones at most once per WARN_PERIOD per kind."""
