@@ -60,6 +60,11 @@ class SchemaError(ValueError):
         self.key = key
         self.message = message
 
+    def named(self, prefix: str) -> str:
+        """The error with the key as the user writes it: "~rate: must be > 0, got 0" (an unknown-key
+        message already names it: "~rtae is not a parameter: ...")."""
+        return self.message if self.message.startswith(f"{prefix}{self.key} ") else f"{prefix}{self}"
+
 
 def _is_number(value: Any) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool)

@@ -130,7 +130,7 @@ class DriverSettings:
         try:
             values = PARAMETERS.attrs(PARAMETERS.load(params, prefix="~"))
         except SchemaError as err:
-            raise ParamError(err.message if err.message.startswith(f"~{err.key} ") else f"~{err}") from None
+            raise ParamError(err.named("~")) from None
         values.setdefault("publish_clock", bool(use_sim_time))
         settings = cls(**values)
         settings.validate()

@@ -69,4 +69,4 @@ def load_settings(params: Mapping[str, Any]) -> NamedPoseSettings:
     try:
         return NamedPoseSettings(**PARAMETERS.attrs(PARAMETERS.load(params, prefix="~")))
     except SchemaError as err:
-        raise ValueError(err.message if err.message.startswith(f"~{err.key} ") else f"~{err}") from None
+        raise ValueError(err.named("~")) from None
