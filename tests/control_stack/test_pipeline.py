@@ -15,6 +15,7 @@ import yaml
 from contact_control.axes import LAW_FOLLOWER
 from contact_control.laws import AxisLaw
 from contact_control.params import load_settings
+from contact_control.stage import Velocity
 from control_stack.pipeline import CompliantPipeline, PipelineOutput
 from jog_arm.settings import JogSettings
 from jog_arm.status import StatusCode
@@ -68,12 +69,13 @@ class Cell:
             self.commands.append((self.t, cycle.velocities))
             self.q = self.q + np.asarray(cycle.velocities) * DT
 
-    def step(self, push_fixed: Sequence[float] | None, nan: bool = False) -> PipelineOutput:
-        """One 2 ms period: the joint state, then the wrench (none if `push_fixed` is None), then tick."""
+    def step(self, push_fixed: Sequence[float] | None, nan: bool = False) -> Velocity | None:
+        """One 2 ms period: the joint state, then the wrench (none if `push_fixed` is None), then tick; the
+        twist the wrench gave (None without a wrench, or when none was due)."""
         self.t += DT
         p = self.pipeline
         p.on_joint_state(self.names, self.q.tolist(), self.t)
-        out = None
+        twist = None
         if push_fixed is not None:
             wrench = (math.nan,) * 6 if nan else self.wrench(push_fixed)
             out = p.on_wrench(wrench, self.cc.ft_sensor_frame, self.t, self.t)
@@ -82,9 +84,7 @@ class Cell:
             p.prepare()
         if self.t >= p.next_due():
             self._apply(p.tick(self.t))
-        if out is not None:
-            out.twist = twist
-        return out if out is not None else p.tick(self.t)
+        return twist
 
     def follower_z(self) -> None:
         laws = [AxisLaw() for _ in range(6)]
@@ -143,10 +143,9 @@ def test_a_stale_wrench_brings_the_arm_to_rest_and_then_silence(cell: Cell) -> N
 def test_a_nan_wrench_yields_a_zero_twist_at_once(cell: Cell) -> None:
     cell.follower_z()
     for _ in range(300):
-        out = cell.step((0.0, 0.0, 4.0))
-    assert out.twist is not None and out.twist[2] > 0.05
-    out = cell.step((0.0, 0.0, 4.0), nan=True)
-    assert out.twist == (0.0,) * 6
+        twist = cell.step((0.0, 0.0, 4.0))
+    assert twist is not None and twist[2] > 0.05
+    assert cell.step((0.0, 0.0, 4.0), nan=True) == (0.0,) * 6
     before = abs(cell.commands[-2][1][1]) + abs(cell.commands[-2][1][2])
     after = abs(cell.commands[-1][1][1]) + abs(cell.commands[-1][1][2])
     assert after < before, "the joint command did not start to slow down"
@@ -164,9 +163,9 @@ def test_an_outside_twist_moves_the_arm_and_its_echo_is_dropped(cell: Cell) -> N
     assert cell.pose("tool_tip")[0, 3] > x0 + 0.01
     # A copy of the pipeline's own twist (same stamp and values) changes nothing.
     cell.follower_z()
-    out = cell.step((0.0, 0.0, 4.0))
-    assert out.twist is not None
-    echo = p.on_twist(out.twist, frame, cell.t, cell.t + 0.0003)
+    twist = cell.step((0.0, 0.0, 4.0))
+    assert twist is not None
+    echo = p.on_twist(twist, frame, cell.t, cell.t + 0.0003)
     assert echo.cycle is None
 
 
@@ -179,11 +178,11 @@ def test_a_clock_jump_back_halts_until_a_fresh_joint_state(cell: Cell) -> None:
     assert out.twist == (0.0,) * 6
     assert out.cycle is not None and out.cycle.status == StatusCode.STALE_JOINT_STATE
     assert "clock jumped back" in out.cycle.message
-    out = cell.step((0.0, 0.0, 4.0))
-    assert out.twist is not None and out.twist[2] < 0.005, "the move did not restart from rest"
+    twist = cell.step((0.0, 0.0, 4.0))
+    assert twist is not None and twist[2] < 0.005, "the move did not restart from rest"
     for _ in range(300):  # data after the jump: the move goes on
-        out = cell.step((0.0, 0.0, 4.0))
-    assert out.twist is not None and out.twist[2] > 0.05
+        twist = cell.step((0.0, 0.0, 4.0))
+    assert twist is not None and twist[2] > 0.05
 
 
 @pytest.mark.parametrize("module", ["control_stack.pipeline", "contact_control.stage", "jog_arm.stage"])
