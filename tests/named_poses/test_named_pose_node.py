@@ -1,8 +1,10 @@
 """named_poses on the simulated UR5: move_to goes there within the joint limits, and refuses what it must."""
 
+import threading
+
 import numpy as np
 import pytest
-from harness.launch import run_launch
+from harness.launch import run_launch, run_node
 from harness.waiting import Collector, wait_until
 
 
@@ -79,3 +81,43 @@ def test_refused_while_a_contact_move_runs(stack):
         assert "a contact move is running" in answer.message
     finally:
         rospy.ServiceProxy("/contact_control_node/stop", Trigger)()
+
+
+def test_a_request_before_the_first_joint_state_waits_for_it_or_says_which_topic_is_silent(stack):
+    """Right after start-up a request can come before the driver's first state reaches the node."""
+    import rospy
+    import yaml
+    from compliant_control_msgs.srv import MoveToNamedPose
+    from rospkg import RosPack
+    from sensor_msgs.msg import JointState
+
+    path = RosPack().get_path("ur5_custom") + "/config/named_poses.yaml"
+    start = yaml.safe_load(open(path))["poses"]["start"]
+    topic = "/late_joint_states"
+    params = {"config": path, "joint_states_topic": topic, "state_wait": 1.5,
+              "trajectory_topic": "/late_trajectory"}
+    with run_node("named_poses", "named_pose_server", params=params, name="late_poses") as node:
+        node.wait_for_service("/late_poses/move_to", timeout=30)
+        move_to = rospy.ServiceProxy("/late_poses/move_to", MoveToNamedPose)
+        t0 = rospy.get_time()
+        silent = move_to(name="start", speed_scale=1.0)
+        assert not silent.success
+        assert topic in silent.message and "1.5 s" in silent.message, silent.message
+        assert rospy.get_time() - t0 >= 1.4, "it waited before refusing"
+
+        pub = rospy.Publisher(topic, JointState, queue_size=1)
+
+        answered = threading.Event()
+
+        def late_states() -> None:  # the driver comes up 0.5 s after the request
+            answered.wait(0.5)
+            while not answered.is_set():
+                pub.publish(JointState(name=list(start), position=list(start.values())))
+                answered.wait(0.05)
+
+        threading.Thread(target=late_states, daemon=True).start()
+        try:
+            answer = move_to(name="start", speed_scale=1.0)
+        finally:
+            answered.set()
+        assert answer.success, answer.message

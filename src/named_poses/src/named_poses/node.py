@@ -48,7 +48,9 @@ class NamedPoseServer:
         self.poses = NamedPoses.from_dict(data, urdf_joints(urdf))
         self.tolerance = settings.goal_tolerance  # [rad]
         self.settle_time = settings.settle_time  # [s] after the planned end
+        self.state_wait = settings.state_wait  # [s] for a first joint state, right after start-up
         self._lock = threading.Lock()
+        self._state_seen = threading.Condition(self._lock)
         self._busy = threading.Lock()
         self._positions: dict[str, float] = {}
         self._status: ContactControlStatus | None = None
@@ -56,6 +58,7 @@ class NamedPoseServer:
             settings.trajectory_topic, JointTrajectory, queue_size=1,
             tcp_nodelay=True,
         )
+        self._states_topic = rospy.resolve_name(settings.joint_states_topic)
         rospy.Subscriber(settings.joint_states_topic, JointState, self._on_joints,
                          queue_size=1, tcp_nodelay=True)
         rospy.Subscriber(settings.contact_control_status,
@@ -68,6 +71,7 @@ class NamedPoseServer:
     def _on_joints(self, msg: JointState) -> None:
         with self._lock:
             self._positions.update(zip(msg.name, msg.position, strict=False))
+            self._state_seen.notify_all()
 
     def _on_status(self, msg: ContactControlStatus) -> None:
         with self._lock:
@@ -78,6 +82,18 @@ class NamedPoseServer:
             if not all(j in self._positions for j in self.poses.joints):
                 return None
             return np.array([self._positions[j] for j in self.poses.joints])
+
+    def _first_state(self) -> np.ndarray | None:
+        """The current joints, waiting up to `~state_wait` for them: a request may come before the driver's
+        first state has reached this node (its subscription connects after the service is up)."""
+        deadline = time.monotonic() + self.state_wait
+        with self._state_seen:
+            while not all(j in self._positions for j in self.poses.joints):
+                left = deadline - time.monotonic()
+                if left <= 0.0 or rospy.is_shutdown():
+                    return None
+                self._state_seen.wait(min(left, 0.1))
+        return self._current()
 
     def _contact_move_running(self) -> bool:
         with self._lock:
@@ -106,9 +122,12 @@ class NamedPoseServer:
                 "a contact move is running (contact_control ~status move_active): stop it first "
                 "(rosservice call /contact_control_node/stop)"
             )
-        current = self._current()
+        current = self._first_state()
         if current is None:
-            return self._refuse(f"no joint state yet for {list(self.poses.joints)}")
+            return self._refuse(
+                f"no joint state for {list(self.poses.joints)} within {self.state_wait:g} s "
+                f"(is the driver publishing {self._states_topic}?)"
+            )
         try:
             goal = self.poses.goal(req.name, current)
             move = plan_move(

@@ -47,6 +47,10 @@ class NamedPoseSettings:
     settle_time: float = param(
         3.0, unit="s", ge=0.0, doc="`~move_to` fails this long after the planned end if not arrived"
     )
+    state_wait: float = param(
+        2.0, unit="s", ge=0.0,
+        doc="`~move_to` waits this long for a joint state of every pose joint before it refuses",
+    )
     trajectory_topic: str = param(
         "arm_controller/command", nonempty=True, doc="trajectory_msgs/JointTrajectory output (the driver's)"
     )
