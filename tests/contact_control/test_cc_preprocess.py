@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 from cc_sim import controller, laws, rot
-from contact_control.axes import LAW_FOLLOWER, SAFETY_NAN, SAFETY_OK, SAFETY_OVER_LIMIT
+from contact_control.axes import LAW_FOLLOWER, SAFETY_NAN, SAFETY_OK, SAFETY_OVER_LIMIT, SAFETY_ZEROING
 from contact_control.laws import AxisLaw
 from contact_control.params import load_settings
 from contact_control.preprocess import PreprocessError, WrenchPreprocessor
@@ -142,9 +142,47 @@ def test_tare_refuses_invalid_data_and_keeps_the_bias():
     assert pre.bias == (1, 2, 3, 4, 5, 6)
 
 
-def test_startup_tare_zeroes_the_first_valid_wrench():
-    ctrl = controller(tare_on_startup=True)
+def test_startup_tare_window_0_zeroes_the_first_valid_wrench():
+    ctrl = controller(tare_on_startup=True, tare_window=0.0)
     ctrl.update([math.nan] * 6, 0.0)  # an invalid first sample is not used
     ctrl.set_laws(laws(z=AxisLaw(LAW_FOLLOWER, damping=30.0)))
     assert ctrl.update([0.5, 0.0, 7.0, 0.0, 0.0, 0.0], 0.002).wrench == pytest.approx([0.0] * 6)
     assert ctrl.update([0.5, 0.0, 17.0, 0.0, 0.0, 0.0], 0.004).wrench[2] > 0.0
+
+
+def _run(ctrl, samples, t0=0.0, period=0.002):
+    """Feeds wrenches at 500 Hz; the results."""
+    return [ctrl.update(list(w), t0 + k * period) for k, w in enumerate(samples)]
+
+
+def test_startup_zeroing_holds_still_over_the_window_then_zeroes_the_mean():
+    ctrl = controller(tare_on_startup=True, lp_filter_enabled=False)
+    ctrl.set_laws(laws(z=AxisLaw(LAW_FOLLOWER, damping=30.0)))  # set before any data: waits
+    rng = np.random.default_rng(7)
+    noisy = [OFFSET + rng.normal(0.0, 0.4, 6) * [1, 1, 1, 0.02, 0.02, 0.02] for _ in range(150)]
+    out = _run(ctrl, noisy)
+    zeroing = [r for r in out if r.safety == SAFETY_ZEROING]
+    assert 95 <= len(zeroing) <= 101, "held for the 0.2 s window at 500 Hz"
+    assert all(r.velocity == [0.0] * 6 for r in zeroing)
+    assert "keep the tool free" in zeroing[0].message
+    assert out[-1].safety == SAFETY_OK
+    # The mean of 100 samples: the bias is within 0.15 N of the offset (one sample: 0.4 N noise).
+    assert np.max(np.abs(np.array(ctrl.preprocessor.bias[:3]) - OFFSET[:3])) < 0.15
+    assert any("sensor zeroed over 0.2 s" in note for note in ctrl.notes)
+
+
+def test_a_touch_that_ends_during_zeroing_is_not_taken_as_the_zero():
+    """The start-up race seen in the simulation: a push present at the first wrench, released soon after.
+    Tared on that first sample, the follower drove the tool the other way (down into the block) once the
+    push ended; the window restarts instead, and the follower stays put."""
+    ctrl = controller(tare_on_startup=True, lp_filter_enabled=False)
+    ctrl.set_laws(laws(z=AxisLaw(LAW_FOLLOWER, damping=30.0)))
+    pushed = [OFFSET + np.array([0, 0, 5.0, 0, 0, 0])] * 50  # 0.1 s of a 5 N push, then the free sensor
+    out = _run(ctrl, pushed + [OFFSET] * 300)
+    restarted = [r for r in out if "changed by 5.00 N" in r.message]
+    assert restarted and restarted[0].safety == SAFETY_ZEROING
+    assert "tare_max_force_spread 4 N" in restarted[0].message
+    assert ctrl.preprocessor.bias == pytest.approx(tuple(OFFSET))
+    assert all(abs(r.velocity[2]) < 1e-9 for r in out), "the follower never moved"
+    up = OFFSET + np.array([0, 0, 6.0, 0, 0, 0])
+    assert _run(ctrl, [up] * 5, t0=1.0)[-1].velocity[2] > 0.0, "then follows a push up"

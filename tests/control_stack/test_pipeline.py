@@ -12,7 +12,7 @@ from collections.abc import Sequence
 import numpy as np
 import pytest
 import yaml
-from contact_control.axes import LAW_FOLLOWER
+from contact_control.axes import LAW_FOLLOWER, SAFETY_ZEROING
 from contact_control.laws import AxisLaw
 from contact_control.params import load_settings
 from contact_control.stage import Velocity
@@ -100,8 +100,9 @@ def robot(request: pytest.FixtureRequest) -> str:
 @pytest.fixture
 def cell(robot: str) -> Cell:
     c = Cell(robot)
-    for _ in range(50):  # the tool's weight only: tared on start-up
+    for _ in range(150):  # the tool's weight only: zeroed on the first 0.2 s at start-up
         c.step((0.0, 0.0, 0.0))
+    assert c.pipeline.contact.ctrl.last_result.safety == 0, c.pipeline.contact.ctrl.last_result.message
     return c
 
 
@@ -222,3 +223,28 @@ def test_requests_are_answered_with_the_reason_and_a_stop_halts_the_arm(cell: Ce
     for _ in range(200):  # the push goes on; the stopped move does not follow it
         cell.step((0.0, 0.0, 4.0))
     assert cell.commands[-1][1] == (0.0,) * len(cell.names)
+
+
+def test_a_law_set_while_the_sensor_is_zeroed_says_so_and_waits(robot: str) -> None:
+    from cartesian_impedance_msgs.msg import ControlLaw
+    from cartesian_impedance_msgs.srv import ConfigureForceControlRequest
+
+    cell = Cell(robot)  # no wrench yet: start-up zeroing has not begun
+    req = ConfigureForceControlRequest()
+    req.cart_impedance_params.damping.translational.z = DAMPING
+    req.direction_control_laws.z.type = ControlLaw.TYPE_FOLLOWER
+    answer = cell.pipeline.configure(req, cell.t)
+    assert answer.ok and "still being zeroed" in answer.message and "keep the tool free" in answer.message
+    cell.step(None)  # the first joint state
+    tip = cell.pose(cell.cc.eef_frame)[:3, 3]
+    for _ in range(90):  # the free sensor for 0.18 s: still zeroing, the law holds still
+        cell.step((0.0, 0.0, 0.0))
+    assert cell.pipeline.contact.ctrl.last_result.safety == SAFETY_ZEROING
+    for _ in range(60):  # zeroed; then a push up is followed
+        cell.step((0.0, 0.0, 0.0))
+    assert np.linalg.norm(cell.pose(cell.cc.eef_frame)[:3, 3] - tip) < 1e-6
+    for _ in range(300):
+        cell.step((0.0, 0.0, 4.0))
+    assert cell.pose(cell.cc.eef_frame)[2, 3] - tip[2] > 0.02
+    answer = cell.pipeline.configure(req, cell.t)
+    assert answer.ok and "zeroed" not in answer.message, "said only while zeroing"

@@ -31,6 +31,7 @@ def test_code_tables_match_the_messages():
         ContactControlStatus.SAFETY_OVER_LIMIT,
         ContactControlStatus.SAFETY_STALE,
         ContactControlStatus.SAFETY_NO_TF,
+        ContactControlStatus.SAFETY_ZEROING,
     }
     assert set(SAFETY_TEXT) == safety
     assert "Reset" in SAFETY_TEXT[ContactControlStatus.SAFETY_OVER_LIMIT]

@@ -15,6 +15,7 @@ pytest.importorskip("cartesian_impedance_msgs.srv", reason="needs devel/setup.ba
 
 from cartesian_impedance_msgs.msg import ControlLaw
 from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
+from compliant_control_msgs.msg import ContactControlStatus
 from compliant_control_msgs.srv import PushEEF, PushEEFRequest
 from geometry_msgs.msg import PoseStamped
 from harness.launch import run_launch
@@ -60,6 +61,10 @@ def test_viewer_opens_a_window_and_the_arm_still_complies(ros_node, display):
         pose = Collector("/mujoco_driver/eef_pose", PoseStamped)
         try:
             pose.wait_for(1, timeout=20)
+            # Set the law once the sensor is zeroed: a push now would be taken as the zero (see
+            # contact_control's README, Zeroing).
+            wait_until(lambda: rospy.wait_for_message(
+                "/contact_control_node/status", ContactControlStatus, 5).safety == 0, 20, "the sensor zeroed")
 
             def tip() -> np.ndarray:
                 p = pose.last().pose.position

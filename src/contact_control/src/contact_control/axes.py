@@ -35,6 +35,7 @@ __all__ = [
     "SAFETY_OK",
     "SAFETY_OVER_LIMIT",
     "SAFETY_STALE",
+    "SAFETY_ZEROING",
     "is_angular",
 ]
 
@@ -91,12 +92,14 @@ SAFETY_NAN = 1
 SAFETY_OVER_LIMIT = 2
 SAFETY_STALE = 3
 SAFETY_NO_TF = 4
+SAFETY_ZEROING = 5
 SAFETY_NAMES = {
     SAFETY_OK: "ok",
     SAFETY_NAN: "invalid wrench",
     SAFETY_OVER_LIMIT: "over global limit",
     SAFETY_STALE: "stale wrench",
     SAFETY_NO_TF: "missing transform",
+    SAFETY_ZEROING: "zeroing the sensor",
 }
 
 

@@ -41,6 +41,7 @@ from contact_control.axes import (
     SAFETY_OK,
     SAFETY_OVER_LIMIT,
     SAFETY_STALE,
+    SAFETY_ZEROING,
 )
 from contact_control.exceeded import ExceededReaction
 from contact_control.laws import AxisLaw, ForceWindow, check_end, law_velocity, shape_velocity
@@ -49,6 +50,7 @@ from contact_control.preprocess import PreprocessError, WrenchPreprocessor, as_r
 from contact_control.rate import SamplePeriod
 from contact_control.request import FAILURE, RequestError
 from contact_control.travel import TravelMeter
+from contact_control.zeroing import SteadyZero
 
 __all__ = ["AxisState", "ContactControl", "CycleResult"]
 
@@ -212,6 +214,10 @@ class ContactControl:
         self._last_rx: float | None = None
         self._last_t: float | None = None
         self._tare_pending = s.tare_on_startup
+        self._zeroing = (
+            SteadyZero(s.tare_window, s.tare_max_force_spread, s.tare_max_torque_spread)
+            if s.tare_on_startup and s.tare_window > 0.0 else None
+        )
         self._last_raw: Sequence[float] | None = None
         self._last_R: Any = None
         self.last_result = self._result(0.0, SAFETY_STALE, "no wrench yet")
@@ -248,6 +254,11 @@ class ContactControl:
     def needs_travel(self) -> bool:
         """Whether the running move uses travel (spring, compliant move, max travel): needs EEF poses."""
         return self._move_active and self._needs_travel
+
+    @property
+    def zeroing(self) -> bool:
+        """Whether start-up zeroing has not finished yet (laws hold still until it has)."""
+        return self._tare_pending
 
     @property
     def safety_latched(self) -> bool:
@@ -447,10 +458,21 @@ class ContactControl:
                 ahead = f"wrench stamped {stamp - t:.3f} s ahead (future_stamp_tolerance {self._future} s)"
                 return self._hold(t, SAFETY_NAN, f"{ahead}: holding until data stamped by this node's clock")
         self._last_rx = t
-        if self._tare_pending and is_finite6(wrench):
-            self.preprocessor.tare(wrench, R_world_sensor)
-            self._tare_pending = False
         self._last_raw, self._last_R = wrench, R_world_sensor
+        if self._tare_pending and is_finite6(wrench):
+            zeroing = self._zeroing
+            if zeroing is None:
+                self.preprocessor.tare(wrench, R_world_sensor)
+            else:
+                bias = zeroing.add(self.preprocessor.bias_estimate(wrench, R_world_sensor), t)
+                if bias is None:
+                    return self._hold(t, SAFETY_ZEROING, zeroing.note)
+                self.preprocessor.set_bias(bias)
+                self.notes.append(
+                    f"sensor zeroed over {zeroing.window:g} s: bias "
+                    f"[{', '.join(f'{b:.3g}' for b in bias)}] (N, Nm, sensor frame, tool weight out)"
+                )
+            self._tare_pending = False
         code, w = self.preprocessor.process(wrench, T_control_sensor, R_world_sensor)
         if code != SAFETY_OK:
             if code == SAFETY_NAN:

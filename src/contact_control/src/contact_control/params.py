@@ -109,7 +109,17 @@ class ContactControlSettings:
     travel_z_direction: int = _sign(
         "legacy sign flip of the measured travel along Z and about Z (the original used -1 for one arm)"
     )
-    tare_on_startup: bool = param(True, doc="tare with the first valid wrench")
+    tare_on_startup: bool = param(
+        True, doc="zero the sensor at start-up: the mean wrench over `tare_window` (laws hold still)"
+    )
+    tare_window: float = _nonneg(
+        0.2, "s", "start-up zeroing averages this long of steady wrenches; 0: the first valid wrench alone"
+    )
+    tare_max_force_spread: float = _pos(
+        4.0, "N", "a force component moving more than this (peak to peak) within the window restarts it "
+        "(a touch or a jolt); above the sensor's noise"
+    )
+    tare_max_torque_spread: float = _pos(0.4, "Nm", "same for torques")
     bias: tuple[float, ...] = param(
         (0.0,) * 6, type="floats", length=6, unit="N, Nm",
         doc="known sensor offset (sensor frame) subtracted until the first tare",

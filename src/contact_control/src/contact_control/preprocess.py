@@ -145,14 +145,22 @@ class WrenchPreprocessor:
         Raises:
             PreprocessError: the reading is not finite or the orientation is missing while tool_mass > 0.
         """
+        self._bias = self.bias_estimate(raw, R_world_sensor)
+        if self._filter:
+            self._filter.reset()
+        return tuple(self._bias)
+
+    def bias_estimate(self, raw: Sequence[float], R_world_sensor: Any = None) -> list[float]:
+        """The bias that would make this reading zero (what `tare` stores), changing nothing.
+
+        Raises:
+            PreprocessError: As `tare`.
+        """
         if len(raw) != 6 or not is_finite6(raw):
             raise PreprocessError(f"cannot tare with an invalid wrench {raw!r}")
         expected = self.gravity_wrench(R_world_sensor)
         w = self._flipped(raw)
-        self._bias = [w[i] - expected[i] for i in range(6)]
-        if self._filter:
-            self._filter.reset()
-        return tuple(self._bias)
+        return [w[i] - expected[i] for i in range(6)]
 
     def contact_force(
         self, raw: Sequence[float], R_world_sensor: Any = None

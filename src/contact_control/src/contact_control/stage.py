@@ -241,7 +241,13 @@ class ContactStage:
         self._request_note = ""
         self._idle_zeros = int(self.settings.idle_zero_count)
         self.ended = True  # a blocking caller of a replaced move answers now
-        return Answer(True, SUCCESS, describe_laws(move_id, laws), move_id)
+        message = describe_laws(move_id, laws)
+        if self.ctrl.zeroing:
+            message += (
+                "; the sensor is still being zeroed (tare_on_startup): the laws act once ~status shows "
+                "safety ok; keep the tool free until then, a touch now would be taken as the zero"
+            )
+        return Answer(True, SUCCESS, message, move_id)
 
     def stop(self, reason: str) -> Velocity | None:
         """Ends the running move; a zero twist to send if one was running."""

@@ -38,6 +38,7 @@ SAFETY_TEXT: dict[int, str] = {
     2: "force over the global limit: holding still until Reset",
     3: "no recent wrench: holding still",
     4: "missing transform: holding still",
+    5: "zeroing the sensor: keep the tool free and still",
 }
 LAW_TEXT: dict[int, str] = {0: "none", 1: "follower", 2: "spring", 3: "compliant move"}
 #: AxisState.exceeded_action while the axis carries it out (AxisState.reacting) after the move ended.

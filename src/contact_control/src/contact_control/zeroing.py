@@ -1,0 +1,69 @@
+"""Zeroing the sensor at start-up over a steady window, not on one sample (see the README, Zeroing).
+
+One sample carries the sensor's noise into the bias for good (0.4 N on an estimated wrench), and a touch at
+that instant becomes a bias that drives a follower the other way once the touch ends. The window's bias
+estimates must stay within a peak-to-peak spread: a change (a touch starting or ending, a jolt) restarts it.
+A contact held perfectly still through the whole window cannot be told from a sensor offset.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+__all__ = ["SteadyZero"]
+
+
+class SteadyZero:
+    """The mean of the bias estimates (sensor frame, tool weight out) over `window` [s] in which no force
+    component moved more than `max_force_spread` [N] and no torque more than `max_torque_spread` [Nm]."""
+
+    def __init__(self, window: float, max_force_spread: float, max_torque_spread: float) -> None:
+        self.window = window
+        self._limits = (max_force_spread,) * 3 + (max_torque_spread,) * 3
+        self._t0: float | None = None
+        self._sum = [0.0] * 6
+        self._low = [0.0] * 6
+        self._high = [0.0] * 6
+        self._count = 0
+        #: Why it is still waiting, in words (for ~status).
+        self.note = "zeroing the sensor: waiting for the first wrench"
+
+    def _restart(self, estimate: Sequence[float], t: float) -> None:
+        self._t0 = t
+        self._sum = list(estimate)
+        self._low = list(estimate)
+        self._high = list(estimate)
+        self._count = 1
+
+    def add(self, estimate: Sequence[float], t: float) -> list[float] | None:
+        """One bias estimate at `t` [s]; the bias once the window is complete, else None (see `note`)."""
+        t0 = self._t0
+        if t0 is None or t < t0:
+            self._restart(estimate, t)
+            t0 = t
+        else:
+            low, high = self._low, self._high
+            for i, value in enumerate(estimate):
+                if value < low[i]:
+                    low[i] = value
+                elif value > high[i]:
+                    high[i] = value
+            worst = max(range(6), key=lambda i: (high[i] - low[i]) / self._limits[i])
+            spread = high[worst] - low[worst]
+            if spread > self._limits[worst]:
+                unit, name = ("N", "force") if worst < 3 else ("Nm", "torque")
+                self.note = (
+                    f"zeroing the sensor: the {name} changed by {spread:.2f} {unit} within "
+                    f"{t - t0:.2f} s (limit tare_max_{name}_spread {self._limits[worst]:g} {unit}): "
+                    "keep the tool free and still"
+                )
+                self._restart(estimate, t)
+                return None
+            for i, value in enumerate(estimate):
+                self._sum[i] += value
+            self._count += 1
+        if t - t0 < self.window:
+            if self._count == 1:
+                self.note = f"zeroing the sensor over {self.window:g} s: keep the tool free and still"
+            return None
+        return [total / self._count for total in self._sum]
