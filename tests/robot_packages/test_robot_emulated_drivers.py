@@ -15,6 +15,7 @@ a user starts it on a real cell, and then (the README's "Real robot" steps):
 from __future__ import annotations
 
 import contextlib
+import pathlib
 
 import numpy as np
 import pytest
@@ -166,13 +167,7 @@ def test_hardware_launch_runs_unchanged_against_the_emulated_driver(ros_node, ro
             assert np.all(np.abs(moved[1:]) < 0.25 * abs(moved[0])), f"tool tip left the X line: {moved}"
             _settle(rospy, cell["joints"])
 
-            # Two axes: a sign error on either (franka's F_ext is the reaction) makes the tool push back.
-            for axis, push in (("x", -10.0), ("y", 10.0)):
-                moved = _follower_gives_way(rospy, pose, cc_status, axis, push)
-                _settle(rospy, cell["joints"])
-                i = "xyz".index(axis)
-                others = np.delete(np.abs(moved), i)
-                assert np.all(others < 0.25 * abs(moved[i])), f"the follower left the {axis} axis: {moved}"
+            _gives_way_on_two_axes(rospy, pose, cc_status, cell["joints"])
             print(f"\n{robot} as {cell['profile']}: jogged 2 cm along -X; the follower gave way to 10 N "
                   "pushes along -X and +Y")
 
@@ -200,3 +195,66 @@ def test_hardware_launch_runs_unchanged_against_the_emulated_driver(ros_node, ro
             pose.close()
             cc_status.close()
             twist_pub.unregister()
+
+
+SRC = pathlib.Path(__file__).resolve().parents[2] / "src"
+# Packages `make robot` wrote: their hardware.launch expects a generic ros_control driver (a
+# joint_trajectory_controller on arm_controller/command, joint_states, a WrenchStamped F/T driver on
+# `wrench`), which is mujoco_driver's own interface (emulated_robot.launch with no profile).
+GENERATED = sorted(
+    p.name for p in SRC.glob("*_custom")
+    if "written by make robot" in (p / "launch/hardware.launch").read_text()
+)
+
+
+def test_some_robot_packages_are_generated():
+    assert GENERATED, "no package written by make robot: the test below would check nothing"
+
+
+def _gives_way_on_two_axes(rospy, pose: Collector, cc_status: Collector, joints_topic: str) -> None:
+    """A 10 N push along -X, then +Y: a sign error on either (franka's F_ext is the reaction) makes the tool
+    push back; a frame error moves it off the axis."""
+    for axis, push in (("x", -10.0), ("y", 10.0)):
+        moved = _follower_gives_way(rospy, pose, cc_status, axis, push)
+        _settle(rospy, joints_topic)
+        i = "xyz".index(axis)
+        others = np.delete(np.abs(moved), i)
+        assert np.all(others < 0.25 * abs(moved[i])), f"the follower left the {axis} axis: {moved}"
+
+
+@pytest.mark.parametrize("robot", GENERATED)
+def test_a_generated_hardware_launch_runs_unchanged_against_a_generic_driver(ros_node, robot):
+    """What a user of a new arm gets from `make robot`: hardware.launch, with no argument, on a driver with
+    the generic interface: a jog moves the tool tip along the line, a follower gives way to pushes on two
+    axes."""
+    import yaml
+
+    rospy = ros_node
+    base = yaml.safe_load((SRC / robot / "config/jog_arm_hardware.yaml").read_text())["planning_frame"]
+    with run_launch("mujoco_driver", "emulated_robot.launch", args={"robot_package": robot}) as driver:
+        driver.wait_for_topic("/joint_states", timeout=40)
+        with run_launch(robot, "hardware.launch") as stack:
+            stack.wait_for_service("/configure_cartesian_impedance", timeout=40)
+            pose = Collector("/mujoco_driver/eef_pose", PoseStamped)
+            cc_status = Collector("/contact_control_node/status", ContactControlStatus)
+            twist_pub = rospy.Publisher("/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1,
+                                        tcp_nodelay=True)
+            try:
+                pose.wait_for(1, timeout=20)
+                zeroed = lambda: cc_status.last() is not None and cc_status.last().safety == 0  # noqa: E731
+                wait_until(zeroed, 20, "contact_control to zero the sensor")
+                wait_until(lambda: twist_pub.get_num_connections() > 0, 10, "jog_arm's input subscribed")
+                moved = _jog(rospy, twist_pub, pose, base, distance=0.02, proc=driver.proc)
+                assert np.all(np.abs(moved[1:]) < 0.25 * abs(moved[0])), f"tool tip left the X line: {moved}"
+                _settle(rospy, "/joint_states")
+                _gives_way_on_two_axes(rospy, pose, cc_status, "/joint_states")
+                print(f"\n{robot}: generated hardware.launch on the generic driver: jogged 2 cm along -X; "
+                      "the follower gave way to 10 N pushes along -X and +Y")
+            finally:
+                pose.close()
+                cc_status.close()
+                twist_pub.unregister()
+            stack.stop()
+            assert stack.proc.returncode == 0, stack.output()[-3000:]
+        driver.stop()
+        assert driver.proc.returncode == 0, driver.output()[-3000:]

@@ -198,7 +198,7 @@ lp_filter_cutoff_freq: 5.0          # [Hz]
 wrench_timeout: 0.25                # [s]
 """
     files["config/contact_control_hardware.yaml"] = f"""# contact_control_node settings for a real {name} with a wrist F/T sensor publishing WrenchStamped on
-# `wrench` (UNTESTED: written by make robot, adapt to your drivers). Loaded on top of contact_control's defaults.
+# `wrench` (written by make robot for a generic driver; run unchanged against mujoco_driver's emulated_robot.launch without a profile; adapt to your drivers). Loaded on top of contact_control's defaults.
 
 ft_in_topic: wrench
 velocity_out_topic: jog_arm_server/delta_jog_cmds
@@ -239,8 +239,8 @@ joint_state_timeout: 0.2            # [s]
 low_pass_filter_coeff: 2.0
 
 {thresholds}"""
-    files["config/jog_arm_hardware.yaml"] = f"""# jog_arm_server settings for a real {name} (UNTESTED: written by make robot; set the topics of your
-# driver). Loaded on top of jog_arm's config/jog_arm.yaml by launch/hardware.launch. Units: m, rad, s.
+    files["config/jog_arm_hardware.yaml"] = f"""# jog_arm_server settings for a real {name} (written by make robot for a generic driver, run against
+# mujoco_driver's emulated_robot.launch without a profile; set the topics of your driver). Loaded on top of jog_arm's config/jog_arm.yaml by launch/hardware.launch. Units: m, rad, s.
 
 move_group_name: manipulator
 ee_frame_name: tool_tip
@@ -303,7 +303,9 @@ low_pass_filter_coeff: 2.5
 """
     files["launch/hardware.launch"] = f"""<?xml version="1.0"?>
 <!--
-  {name} compliant-control stack against a real robot (UNTESTED: written by make robot). Start the robot's
+  {name} compliant-control stack against a real robot (written by make robot for a generic ros_control
+  driver; not run on a real arm, but run unchanged against `roslaunch mujoco_driver emulated_robot.launch
+  robot_package:={name}_custom`, tests/robot_packages/test_robot_emulated_drivers.py). Start the robot's
   driver first with a joint_trajectory_controller on {TRAJECTORY_TOPIC} and a wrist F/T sensor driver
   publishing WrenchStamped on `wrench`; set other topics in config/*_hardware.yaml.
 -->
@@ -379,7 +381,7 @@ scripts/with_env rosservice call /named_poses/move_to "{{name: home}}"
 | `config/demos.yaml` | the demonstrations' directions and distances, scaled to the reach (~{plan.reach:.2f} m) |
 | `config/named_poses.yaml` | `start` (= the scene's start pose) and `home` (the tool lifted) for `/named_poses/move_to` |
 | `config/contact_control.yaml`, `config/jog_arm.yaml` | the stack on top of its defaults: frames (`{plan.base}`), tool mass and COM, thresholds |
-| `config/*_hardware.yaml`, `launch/hardware.launch` | the same for a real arm: UNTESTED, set your drivers' topics |
+| `config/*_hardware.yaml`, `launch/hardware.launch` | the same for a real arm with a generic ros_control driver (tested against `emulated_robot.launch` without a profile); set your drivers' topics |
 | `launch/sim.launch`, `launch/keyboard.launch` | the simulated stack; keyboard jogging |
 
 ## Start pose analysis (printed by `make robot`)
