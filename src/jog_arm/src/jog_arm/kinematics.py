@@ -85,6 +85,8 @@ class ArmModel:
         self.data = model.createData()
         self._pose_data = model.createData()  # for measured_pose, so it never disturbs a cycle's data
         self._pose_q: object = None
+        self._step_data = model.createData()  # for tip_displacement (called between cycles' uses of data)
+        self._q_pin_step = pin.neutral(model)
         self.nv = model.nv
         # Kinematic order of the controlled joints: index i of every array in this class.
         self.joint_names: tuple[str, ...] = tuple(model.names[1:])
@@ -227,6 +229,22 @@ class ArmModel:
             pose = base.actInv(pose)
         return pose
 
+
+    def tip_displacement(
+        self, q_from: Sequence[float] | np.ndarray, q_to: Sequence[float] | np.ndarray, out: np.ndarray
+    ) -> np.ndarray:
+        """The tip's displacement from `q_from` to `q_to` (model order) into `out` (6): translation, then
+        rotation vector, both in root axes: what a LOCAL_WORLD_ALIGNED tip twist held constant integrates to.
+        Uses data of its own (the cycle's data keeps its placements)."""
+        model, data, tip = self.model, self._step_data, self.tip_id
+        pin.forwardKinematics(model, data, self.pin_q(np.asarray(q_from, dtype=float), self._q_pin_step))
+        start = pin.updateFramePlacement(model, data, tip)
+        p0, R0 = start.translation.copy(), start.rotation.copy()
+        pin.forwardKinematics(model, data, self.pin_q(np.asarray(q_to, dtype=float), self._q_pin_step))
+        end = pin.updateFramePlacement(model, data, tip)
+        out[:3] = end.translation - p0
+        out[3:] = pin.log3(end.rotation @ R0.T)
+        return out
 
     def measured_pose(self, q: Sequence[float], frame_id: int, base_id: int) -> np.ndarray:
         """4x4 pose of frame `frame_id` in frame `base_id` at `q` (model order).
