@@ -362,9 +362,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"make robot: error: {exc}", file=sys.stderr)
         return 2
     root = write_package(plan, args.src)
-    demo = f"`make demo ROBOT={spec.name}`" + (f" or `make demo ROBOT={spec.name} DRIVER={spec.driver}`"
-                                                if spec.driver else "")
-    print(f"[robot] wrote {root} (run `make build`, then {demo})")
+    print(f"[robot] wrote {root} (run `make build`, then `make demo ROBOT={spec.name}`)")
     from robot_setup.check import check_package, print_report
 
     problems = check_package(root)
