@@ -30,10 +30,12 @@ demo: build
 	@$(ENV) python scripts/demo --robot $(ROBOT) $(if $(DRIVER),--driver $(DRIVER))
 
 # make robot NAME=<name> URDF=<path, or relative to example-robot-data's robots/> TIP=<flange link>
-#   [BASE=<link>] [TOOL_MASS=<kg>]: writes src/<name>_custom/ and checks it.
+#   [BASE=<link>] [TOOL_MASS=<kg>] [DRIVER=<mujoco_driver profile name or YAML path>]: writes
+#   src/<name>_custom/ (hardware files for that driver; none: a generic ros_control driver) and checks it.
 robot: build
 	@$(ENV) python -m robot_setup.generate --name "$(NAME)" --urdf "$(URDF)" --tip "$(TIP)" \
-		$(if $(BASE),--base "$(BASE)") $(if $(TOOL_MASS),--tool-mass "$(TOOL_MASS)") --src src
+		$(if $(BASE),--base "$(BASE)") $(if $(TOOL_MASS),--tool-mass "$(TOOL_MASS)") \
+		$(if $(DRIVER),--driver "$(DRIVER)") --src src
 	@scripts/bootstrap >/dev/null
 
 check-robot: build

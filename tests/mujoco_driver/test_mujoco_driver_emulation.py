@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from mujoco_driver.controllers import BEST_EFFORT, STRICT, ControllerManager, ControllerSpec
 from mujoco_driver.emulation import DriverEmulation
-from mujoco_driver.profiles import ProfileError, WrenchSpec, load_profile
+from mujoco_driver.profiles import ProfileError, WrenchSpec, known_profiles, load_profile
 from mujoco_driver.wrench_models import RateDivider, Reflex, WrenchModel, change_frame, gravity_wrench
 
 PROFILE_FOR = {"ur5_custom": "ur_robot_driver", "panda_custom": "franka_ros"}
@@ -37,6 +37,12 @@ def test_franka_profile_resolves_arm_id_and_rate_options():
     assert p.reflex.force_thresholds == (20.0, 20.0, 20.0, 25.0, 25.0, 25.0)
     other = load_profile("franka_ros", {"arm_id": "fr3", "publish_rate": 100.0})
     assert other.publish_rate == 100.0 and other.wrench.frame == "fr3_K" and other.tf[0].parent == "fr3_link8"
+
+
+def test_known_profiles_are_the_files_in_config_profiles():
+    assert known_profiles() == ["franka_ros", "ur_robot_driver"]
+    with pytest.raises(ProfileError, match=r"profiles: \['franka_ros', 'ur_robot_driver'\]"):
+        load_profile("no_such_driver")
 
 
 @pytest.mark.parametrize("source, options, message", [

@@ -10,6 +10,11 @@ a user starts it on a real cell, and then (the README's "Real robot" steps):
   makes the tool give way to a simulated push;
 * Panda: a push over the collision threshold trips the reflex: the arm takes no motion until
   franka_control/error_recovery is called.
+
+Every package `make robot` wrote runs the same way against the driver its recorded command names
+(`DRIVER=<profile>`: emulated_robot.launch with that profile; none: the generic interface): the controller
+switch, when the profile starts jog_arm's controller stopped, takes its names from the profile and the
+package's jog_arm_hardware.yaml (a helper shared with the UR5 case).
 """
 
 from __future__ import annotations
@@ -19,6 +24,7 @@ import pathlib
 
 import numpy as np
 import pytest
+import yaml
 
 pytest.importorskip("controller_manager_msgs.srv", reason="needs devel/setup.bash (make test sources it)")
 
@@ -32,6 +38,8 @@ from driver_emulation_msgs.msg import ErrorRecoveryAction, ErrorRecoveryGoal
 from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
 from harness.launch import run_launch
 from harness.waiting import Collector, wait_until
+from mujoco_driver.profiles import DriverProfile, load_profile
+from robot_setup.generate import recorded_command
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64, String
 from std_srvs.srv import Trigger
@@ -47,12 +55,12 @@ CELLS = {
 
 
 @contextlib.contextmanager
-def _cell(robot: str):
-    """Emulated driver first, then the robot package's hardware.launch, unchanged (no arguments)."""
-    cell = CELLS[robot]
-    with run_launch("mujoco_driver", "emulated_robot.launch",
-                    args={"robot_package": robot, "profile": cell["profile"]}) as driver:
-        driver.wait_for_topic(cell["joints"], timeout=40)
+def _cell(robot: str, profile: str, joints: str):
+    """The emulated driver first (``profile`` "": the generic interface), then the robot package's
+    hardware.launch, unchanged (no arguments)."""
+    args = {"robot_package": robot, **({"profile": profile} if profile else {})}
+    with run_launch("mujoco_driver", "emulated_robot.launch", args=args) as driver:
+        driver.wait_for_topic(joints, timeout=40)
         with run_launch(robot, "hardware.launch") as stack:
             stack.wait_for_service("/configure_cartesian_impedance", timeout=40)
             stack.wait_for_topic("/contact_control_node/status", timeout=40)
@@ -61,6 +69,21 @@ def _cell(robot: str):
             assert stack.proc.returncode == 0, stack.output()[-3000:]
         driver.stop()
         assert driver.proc.returncode == 0, driver.output()[-3000:]
+
+
+@contextlib.contextmanager
+def _clients(rospy):
+    """The test's ends: the ground-truth tool tip, contact_control's status, jog_arm's twist input."""
+    pose = Collector("/mujoco_driver/eef_pose", PoseStamped)
+    cc_status = Collector("/contact_control_node/status", ContactControlStatus)
+    twist_pub = rospy.Publisher("/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1,
+                                tcp_nodelay=True)
+    try:
+        yield pose, cc_status, twist_pub
+    finally:
+        pose.close()
+        cc_status.close()
+        twist_pub.unregister()
 
 
 def _tip(pose: Collector) -> np.ndarray:
@@ -117,88 +140,117 @@ def _follower_gives_way(rospy, pose: Collector, cc_status: Collector, axis: str,
     return moved
 
 
+def _controller_states(rospy, profile: DriverProfile) -> dict[str, str]:
+    list_controllers = rospy.ServiceProxy(f"/{profile.controller_manager}/list_controllers", ListControllers)
+    return {c.name: c.state for c in list_controllers().controller}
+
+
+def _switch_on_jog_controller(rospy, driver, twist_pub, pose: Collector, base: str, robot: str,
+                              profile: DriverProfile) -> str:
+    """The controller jog_arm commands (``cmd_out_topic`` of the package's jog_arm_hardware.yaml) is one of
+    the profile's. If the driver starts it not running, as ur_robot_driver its velocity controller, jog_arm's
+    commands are ignored (the arm stays put, the driver names the controller) until the user switches it on
+    through controller_manager/switch_controller, stopping the running controllers that command the joints
+    (a resource conflict otherwise). Returns what was done, in words."""
+    jog = yaml.safe_load((SRC / robot / "config/jog_arm_hardware.yaml").read_text())
+    name = jog["cmd_out_topic"].strip("/").rsplit("/command", 1)[0]
+    specs = {c.name: c for c in profile.controllers}
+    assert name in specs and specs[name].command != "none", (
+        f"jog_arm commands {jog['cmd_out_topic']}: not a command controller of {profile.driver}")
+    states = _controller_states(rospy, profile)
+    assert states == {c.name: c.initial_state for c in profile.controllers}
+    if states[name] == "running":
+        return f"{name} running from the start"
+    ignored = _jog(rospy, twist_pub, pose, base, messages=50, proc=driver.proc)
+    assert np.linalg.norm(ignored) < 1e-3, f"a controller that is not running moved the arm: {ignored}"
+    assert f"{name} is {states[name]}" in driver.output()
+    stop = [c.name for c in profile.controllers if c.command != "none" and states[c.name] == "running"]
+    req = SwitchControllerRequest(start_controllers=[name], stop_controllers=stop,
+                                  strictness=SwitchControllerRequest.STRICT)
+    assert rospy.ServiceProxy(f"/{profile.controller_manager}/switch_controller", SwitchController)(req).ok
+    states = _controller_states(rospy, profile)
+    assert states[name] == "running" and all(states[c] == "stopped" for c in stop), states
+    return f"switched {name} on, stopping {', '.join(stop) or 'nothing'}"
+
+
+def _driver_extras(rospy, profile: DriverProfile, wrench: WrenchStamped) -> None:
+    """What the profile promises beyond topics: the speed scaling at 1.0, a payload-compensated wrench that
+    reads no tool weight at rest, the zero service."""
+    if profile.speed_scaling_topic:
+        assert rospy.wait_for_message(f"/{profile.speed_scaling_topic}", Float64, timeout=5).data == 1.0
+    if profile.wrench.model == "payload_compensated":
+        f = wrench.wrench.force
+        assert np.linalg.norm([f.x, f.y, f.z]) < 0.5, f"payload not compensated: {f}"
+    if profile.wrench.zero_service:
+        assert rospy.ServiceProxy(f"/{profile.wrench.zero_service}", Trigger)().success
+
+
+def _jog_and_push(rospy, robot: str, cell: dict, profile: DriverProfile | None, driver, clients) -> str:
+    """The README's *Real robot* steps after the launch: the driver's wrench (frame, rate), the controller
+    switch if the profile needs one, a jog of 2 cm along -X that stays on the line, then a follower that gives
+    way to pushes along -X and +Y. Returns what was done about controllers, in words."""
+    pose, cc_status, twist_pub = clients
+    wrench = rospy.wait_for_message(cell["wrench"], WrenchStamped, timeout=10)
+    assert wrench.header.frame_id == cell["frame"]
+    pose.wait_for(1, timeout=20)
+    cc_status.wait_for(1, timeout=20)
+    if cell["rate"]:
+        # The driver's rate, from the stamps (the real drivers' defaults: CB3 125 Hz, franka 30 Hz).
+        wrenches = Collector(cell["wrench"], WrenchStamped)
+        wrenches.wait_for(40, timeout=10)
+        wrenches.close()
+        stamps = np.array([m.header.stamp.to_sec() for m in wrenches.msgs])
+        assert np.median(np.diff(stamps)) == pytest.approx(1.0 / cell["rate"], rel=0.15)
+    wait_until(lambda: twist_pub.get_num_connections() > 0, 10, "jog_arm to subscribe to its input")
+    switched = "generic interface, no controller manager"
+    if profile is not None:
+        _driver_extras(rospy, profile, wrench)
+        switched = _switch_on_jog_controller(rospy, driver, twist_pub, pose, cell["base"], robot, profile)
+    zeroed = lambda: cc_status.last().safety == ContactControlStatus.SAFETY_OK  # noqa: E731
+    wait_until(zeroed, 20, "contact_control to zero the sensor")
+    moved = _jog(rospy, twist_pub, pose, cell["base"], distance=0.02, proc=driver.proc)
+    assert np.all(np.abs(moved[1:]) < 0.25 * abs(moved[0])), f"tool tip left the X line: {moved}"
+    _settle(rospy, cell["joints"])
+    _gives_way_on_two_axes(rospy, pose, cc_status, cell["joints"])
+    return switched
+
+
 @pytest.mark.parametrize("robot", ["ur5_custom", "panda_custom"])
 def test_hardware_launch_runs_unchanged_against_the_emulated_driver(ros_node, robot):
     rospy = ros_node
     cell = CELLS[robot]
-    with _cell(robot) as (driver, _stack):
-        wrench = rospy.wait_for_message(cell["wrench"], WrenchStamped, timeout=10)
-        assert wrench.header.frame_id == cell["frame"]
-        pose = Collector("/mujoco_driver/eef_pose", PoseStamped)
-        cc_status = Collector("/contact_control_node/status", ContactControlStatus)
-        twist_pub = rospy.Publisher("/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1,
-                                    tcp_nodelay=True)
-        try:
-            pose.wait_for(1, timeout=20)
-            cc_status.wait_for(1, timeout=20)
-            # The driver's rate, from the stamps (the real drivers' defaults: CB3 125 Hz, franka 30 Hz).
-            wrenches = Collector(cell["wrench"], WrenchStamped)
-            wrenches.wait_for(40, timeout=10)
-            wrenches.close()
-            stamps = np.array([m.header.stamp.to_sec() for m in wrenches.msgs])
-            assert np.median(np.diff(stamps)) == pytest.approx(1.0 / cell["rate"], rel=0.15)
-            wait_until(lambda: twist_pub.get_num_connections() > 0, 10, "jog_arm to subscribe to its input")
-            list_controllers = rospy.ServiceProxy("/controller_manager/list_controllers", ListControllers)
-            states = {c.name: c.state for c in list_controllers().controller}
-
-            if robot == "ur5_custom":
-                # The real UR's defaults: 125 Hz, the wrench already without the tool's weight.
-                assert rospy.wait_for_message("/speed_scaling_factor", Float64, timeout=5).data == 1.0
-                f = wrench.wrench.force
-                assert np.linalg.norm([f.x, f.y, f.z]) < 0.5, f"payload not compensated: {f}"
-                assert rospy.ServiceProxy("/ur_hardware_interface/zero_ftsensor", Trigger)().success
-                assert states["scaled_pos_joint_traj_controller"] == "running"
-                assert states["joint_group_vel_controller"] == "initialized"
-                # jog_arm's velocity commands go to a controller that is not running: the arm stays put.
-                ignored = _jog(rospy, twist_pub, pose, cell["base"], messages=50, proc=driver.proc)
-                assert np.linalg.norm(ignored) < 1e-3, f"a stopped controller moved the arm: {ignored}"
-                assert "joint_group_vel_controller is initialized" in driver.output()
-                req = SwitchControllerRequest(start_controllers=["joint_group_vel_controller"],
-                                              stop_controllers=["scaled_pos_joint_traj_controller"],
-                                              strictness=SwitchControllerRequest.STRICT)
-                assert rospy.ServiceProxy("/controller_manager/switch_controller", SwitchController)(req).ok
-                states = {c.name: c.state for c in list_controllers().controller}
-                assert states["joint_group_vel_controller"] == "running"
-                assert states["scaled_pos_joint_traj_controller"] == "stopped"
-            else:
-                assert states["position_joint_trajectory_controller"] == "running"
-
-            moved = _jog(rospy, twist_pub, pose, cell["base"], distance=0.02, proc=driver.proc)
-            assert np.all(np.abs(moved[1:]) < 0.25 * abs(moved[0])), f"tool tip left the X line: {moved}"
+    profile = load_profile(cell["profile"])
+    with _cell(robot, cell["profile"], cell["joints"]) as (driver, _stack), _clients(rospy) as clients:
+        switched = _jog_and_push(rospy, robot, cell, profile, driver, clients)
+        print(f"\n{robot} as {cell['profile']} ({switched}): jogged 2 cm along -X; the follower gave way to "
+              "10 N pushes along -X and +Y")
+        if profile.reflex is not None:
+            # Over the collision threshold (franka's 20 N): the reflex stops the arm until error recovery.
+            pose, _cc_status, twist_pub = clients
+            mode = Collector("/mujoco_driver/robot_mode", String)
+            mode.wait_for(1, timeout=5)
+            assert mode.last().data == "move"
+            push = PushEEFRequest(duration=0.3)
+            push.wrench.force.z = -1.5 * profile.reflex.force_thresholds[2]
+            assert rospy.ServiceProxy("/mujoco_driver/push", PushEEF)(push).success
+            wait_until(lambda: mode.last().data == "reflex", 10, "the reflex to trip")
             _settle(rospy, cell["joints"])
-
-            _gives_way_on_two_axes(rospy, pose, cc_status, cell["joints"])
-            print(f"\n{robot} as {cell['profile']}: jogged 2 cm along -X; the follower gave way to 10 N "
-                  "pushes along -X and +Y")
-
-            if robot == "panda_custom":
-                # Over franka's 20 N collision threshold: the reflex stops the arm until error recovery.
-                mode = Collector("/mujoco_driver/robot_mode", String)
-                mode.wait_for(1, timeout=5)
-                assert mode.last().data == "move"
-                push = PushEEFRequest(duration=0.3)
-                push.wrench.force.z = -30.0
-                assert rospy.ServiceProxy("/mujoco_driver/push", PushEEF)(push).success
-                wait_until(lambda: mode.last().data == "reflex", 10, "the reflex to trip")
-                _settle(rospy, cell["joints"])
-                held = _jog(rospy, twist_pub, pose, cell["base"], messages=50, proc=driver.proc)
-                assert np.linalg.norm(held) < 2e-3, f"the arm moved in reflex mode: {held}"
-                recovery = actionlib.SimpleActionClient("/franka_control/error_recovery", ErrorRecoveryAction)
-                assert recovery.wait_for_server(rospy.Duration(10))
-                recovery.send_goal(ErrorRecoveryGoal())
-                assert recovery.wait_for_result(rospy.Duration(10))
-                wait_until(lambda: mode.last().data == "move", 5, "the robot mode back to move")
-                moved = _jog(rospy, twist_pub, pose, cell["base"], distance=0.01, proc=driver.proc)
-                print(f"{robot}: a 30 N push tripped the reflex; after error recovery the arm jogged again")
-                mode.close()
-        finally:
-            pose.close()
-            cc_status.close()
-            twist_pub.unregister()
+            held = _jog(rospy, twist_pub, pose, cell["base"], messages=50, proc=driver.proc)
+            assert np.linalg.norm(held) < 2e-3, f"the arm moved in reflex mode: {held}"
+            recovery = actionlib.SimpleActionClient(f"/{profile.reflex.recovery_action}", ErrorRecoveryAction)
+            assert recovery.wait_for_server(rospy.Duration(10))
+            recovery.send_goal(ErrorRecoveryGoal())
+            assert recovery.wait_for_result(rospy.Duration(10))
+            wait_until(lambda: mode.last().data == "move", 5, "the robot mode back to move")
+            _jog(rospy, twist_pub, pose, cell["base"], distance=0.01, proc=driver.proc)
+            print(f"{robot}: a {-push.wrench.force.z:g} N push tripped the reflex; after error recovery the "
+                  "arm jogged again")
+            mode.close()
 
 
 SRC = pathlib.Path(__file__).resolve().parents[2] / "src"
-# Packages `make robot` wrote: their hardware.launch expects a generic ros_control driver (a
+# Packages `make robot` wrote. Their hardware.launch is for the driver their README's `make robot` command
+# names (DRIVER=<profile>: that mujoco_driver profile), or without DRIVER for a generic ros_control driver (a
 # joint_trajectory_controller on arm_controller/command, joint_states, a WrenchStamped F/T driver on
 # `wrench`), which is mujoco_driver's own interface (emulated_robot.launch with no profile).
 GENERATED = sorted(
@@ -222,39 +274,31 @@ def _gives_way_on_two_axes(rospy, pose: Collector, cc_status: Collector, joints_
         assert np.all(others < 0.25 * abs(moved[i])), f"the follower left the {axis} axis: {moved}"
 
 
-@pytest.mark.parametrize("robot", GENERATED)
-def test_a_generated_hardware_launch_runs_unchanged_against_a_generic_driver(ros_node, robot):
-    """What a user of a new arm gets from `make robot`: hardware.launch, with no argument, on a driver with
-    the generic interface: a jog moves the tool tip along the line, a follower gives way to pushes on two
-    axes."""
-    import yaml
-
-    rospy = ros_node
+def _generated_cell(robot: str) -> tuple[dict, DriverProfile | None]:
+    """What a user of a generated package has: the driver its recorded `make robot` command names, with
+    that profile's names (none: the generic interface), and the base frame of its jog_arm config."""
+    spec = recorded_command((SRC / robot / "README.md").read_text())
+    assert spec is not None, f"{robot}: written by make robot, but its README records no command"
     base = yaml.safe_load((SRC / robot / "config/jog_arm_hardware.yaml").read_text())["planning_frame"]
-    with run_launch("mujoco_driver", "emulated_robot.launch", args={"robot_package": robot}) as driver:
-        driver.wait_for_topic("/joint_states", timeout=40)
-        with run_launch(robot, "hardware.launch") as stack:
-            stack.wait_for_service("/configure_cartesian_impedance", timeout=40)
-            pose = Collector("/mujoco_driver/eef_pose", PoseStamped)
-            cc_status = Collector("/contact_control_node/status", ContactControlStatus)
-            twist_pub = rospy.Publisher("/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1,
-                                        tcp_nodelay=True)
-            try:
-                pose.wait_for(1, timeout=20)
-                zeroed = lambda: cc_status.last() is not None and cc_status.last().safety == 0  # noqa: E731
-                wait_until(zeroed, 20, "contact_control to zero the sensor")
-                wait_until(lambda: twist_pub.get_num_connections() > 0, 10, "jog_arm's input subscribed")
-                moved = _jog(rospy, twist_pub, pose, base, distance=0.02, proc=driver.proc)
-                assert np.all(np.abs(moved[1:]) < 0.25 * abs(moved[0])), f"tool tip left the X line: {moved}"
-                _settle(rospy, "/joint_states")
-                _gives_way_on_two_axes(rospy, pose, cc_status, "/joint_states")
-                print(f"\n{robot}: generated hardware.launch on the generic driver: jogged 2 cm along -X; "
-                      "the follower gave way to 10 N pushes along -X and +Y")
-            finally:
-                pose.close()
-                cc_status.close()
-                twist_pub.unregister()
-            stack.stop()
-            assert stack.proc.returncode == 0, stack.output()[-3000:]
-        driver.stop()
-        assert driver.proc.returncode == 0, driver.output()[-3000:]
+    if not spec.driver:
+        return dict(profile="", base=base, joints="/joint_states", wrench="/wrench", frame="ft_sensor",
+                    rate=None), None
+    profile = load_profile(spec.driver)
+    cell = dict(profile=spec.driver, base=base, joints=f"/{profile.joint_states_topic}",
+                wrench=f"/{profile.wrench.topic}", frame=profile.wrench.frame, rate=profile.publish_rate)
+    return cell, profile
+
+
+@pytest.mark.parametrize("robot", GENERATED)
+def test_a_generated_hardware_launch_runs_unchanged_against_its_driver(ros_node, robot):
+    """What a user of a new arm gets from `make robot [DRIVER=...]`: hardware.launch, with no argument, on
+    the driver it was written for (emulated with the recorded profile, or the generic interface): after the
+    controller switch the profile needs, a jog moves the tool tip along the line, a follower gives way to
+    pushes on two axes."""
+    rospy = ros_node
+    cell, profile = _generated_cell(robot)
+    with _cell(robot, cell["profile"], cell["joints"]) as (driver, _stack), _clients(rospy) as clients:
+        switched = _jog_and_push(rospy, robot, cell, profile, driver, clients)
+        on = cell["profile"] or "the generic driver"
+        print(f"\n{robot}: generated hardware.launch on {on} ({switched}): jogged 2 cm along -X; the "
+              "follower gave way to 10 N pushes along -X and +Y")

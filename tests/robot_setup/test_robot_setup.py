@@ -5,25 +5,20 @@ generated packages are exactly what `make robot` writes)."""
 from __future__ import annotations
 
 import pathlib
-import re
 import shutil
 
 import pytest
 import yaml
 from robot_setup.check import check_package
+from robot_setup.generate import RobotSpec, recorded_command
 
 SRC = pathlib.Path(__file__).resolve().parents[2] / "src"
 ROBOT_PACKAGES = sorted(p.name for p in SRC.iterdir() if p.name.endswith("_custom"))
 
 
-def _generated_command(package: str) -> dict | None:
+def _generated_command(package: str) -> RobotSpec | None:
     """The `make robot` arguments a generated package records in its README (None: hand-written)."""
-    match = re.search(r"`make robot NAME=(\S+) URDF=(\S+) TIP=(\S+)(?: BASE=(\S+))? TOOL_MASS=(\S+)`",
-                      (SRC / package / "README.md").read_text())
-    if not match:
-        return None
-    name, urdf, tip, base, mass = match.groups()
-    return {"name": name, "urdf": urdf, "tip": tip, "base": base or "", "tool_mass": float(mass)}
+    return recorded_command((SRC / package / "README.md").read_text())
 
 
 GENERATED = [p for p in ROBOT_PACKAGES if _generated_command(p)]
@@ -105,9 +100,10 @@ def test_generator_refuses_an_unknown_flange_and_names_the_links():
 @pytest.mark.parametrize("package", GENERATED)
 def test_make_robot_writes_the_committed_package_again(package, tmp_path):
     """Reproducible: the same command gives the same files (the start pose search included)."""
-    from robot_setup.generate import RobotSpec, plan_robot, write_package
+    from robot_setup.generate import plan_robot, write_package
 
-    spec = RobotSpec(**_generated_command(package))
+    spec = _generated_command(package)
+    assert spec is not None
     root = pathlib.Path(write_package(plan_robot(spec, log=lambda _: None), str(tmp_path)))
     written = sorted(p.relative_to(root) for p in root.rglob("*") if p.is_file())
     committed = sorted(p.relative_to(SRC / package) for p in (SRC / package).rglob("*") if p.is_file())

@@ -25,8 +25,8 @@ import yaml
 
 from mujoco_driver.controllers import ControllerError, ControllerSpec
 
-__all__ = ["DriverProfile", "FrameLink", "ProfileError", "ReflexSpec", "WrenchSpec", "load_profile",
-           "profile_path"]
+__all__ = ["DriverProfile", "FrameLink", "ProfileError", "ReflexSpec", "WrenchSpec", "known_profiles",
+           "load_profile", "profile_path"]
 
 PROFILE_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
                            "config", "profiles")
@@ -136,6 +136,13 @@ class DriverProfile:
         return names
 
 
+def known_profiles() -> list[str]:
+    """The profile names in ``config/profiles`` (sorted)."""
+    if not os.path.isdir(PROFILE_DIR):
+        return []
+    return sorted(f[:-5] for f in os.listdir(PROFILE_DIR) if f.endswith(".yaml"))
+
+
 def profile_path(name_or_path: str) -> str:
     """The YAML file of a profile name (``config/profiles/<name>.yaml``) or a path.
 
@@ -147,9 +154,7 @@ def profile_path(name_or_path: str) -> str:
     else:
         path = os.path.join(PROFILE_DIR, f"{name_or_path}.yaml")
     if not os.path.isfile(path):
-        known = sorted(f[:-5] for f in os.listdir(PROFILE_DIR) if f.endswith(".yaml")) if os.path.isdir(
-            PROFILE_DIR) else []
-        raise ProfileError(f"driver profile {name_or_path!r}: no file {path} (profiles: {known})")
+        raise ProfileError(f"driver profile {name_or_path!r}: no file {path} (profiles: {known_profiles()})")
     return path
 
 

@@ -11,6 +11,11 @@ numbers that depend on the arm are measured here (Pinocchio, `robot_setup.analys
   * jog_arm's singularity thresholds from the condition numbers measured along those motions;
   * servo gains from the URDF's joint efforts.
 
+The hardware files (`config/*_hardware.yaml`, `launch/hardware.launch`) are written for a generic
+ros_control driver, or with `DRIVER=<profile>` for the real driver a mujoco_driver profile describes
+(`robot_setup.driver`: topics, wrench frame, sign and payload handling, controllers, all from the profile's
+data). The simulation's files do not depend on the driver.
+
 Reproducible: fixed grids and seeds, rounded numbers, no dates; the same command writes the same files.
 """
 
@@ -19,6 +24,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import re
 import sys
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
@@ -46,8 +52,10 @@ from robot_setup.analysis import (
     lowest_joint,
 )
 from robot_setup.collisions import CollisionChecker
+from robot_setup.driver import DriverError, DriverInterface, driver_interface
 
-__all__ = ["GeneratorError", "Plan", "RobotSpec", "main", "plan_robot", "render", "write_package"]
+__all__ = ["GeneratorError", "Plan", "RobotSpec", "command_line", "main", "plan_robot", "recorded_command",
+           "render", "write_package"]
 
 # Arms whose tool tip reaches this far from the base axis [m] get the thesis-sized demo motions
 # (0.30 m hybrid travel, obstacle 7 cm below the tip); shorter arms get them scaled by reach / this. The
@@ -66,13 +74,48 @@ class GeneratorError(ValueError):
 
 @dataclass(frozen=True)
 class RobotSpec:
-    """What the user gives: `make robot NAME=... URDF=... TIP=... [BASE=...] [TOOL_MASS=...]`."""
+    """What the user gives: `make robot NAME=... URDF=... TIP=... [BASE=...] [TOOL_MASS=...] [DRIVER=...]`."""
 
     name: str
     urdf: str  # a path, or a path relative to example-robot-data's robots/
     tip: str  # the flange link the sensor and tool go on
     base: str = ""  # the base frame; empty: the URDF root (or its only fixed child, if the root is a 'world')
     tool_mass: float = 1.0  # [kg]
+    driver: str = ""  # a mujoco_driver profile name or YAML path the hardware files are for; empty: generic
+
+
+def command_line(spec: RobotSpec, with_driver: bool = True) -> str:
+    """The `make robot` command of `spec` (what the package records; `recorded_command` reads it back).
+
+    Args:
+        spec: The command's arguments.
+        with_driver: Include `DRIVER=` (the simulation's files leave it out: they are the same for any
+            driver).
+    """
+
+    def num(v: float) -> str:
+        return f"{v:.10g}"
+
+    return (
+        f"make robot NAME={spec.name} URDF={spec.urdf} TIP={spec.tip}"
+        + (f" BASE={spec.base}" if spec.base else "")
+        + f" TOOL_MASS={num(spec.tool_mass)}"
+        + (f" DRIVER={spec.driver}" if with_driver and spec.driver else "")
+    )
+
+
+_COMMAND = re.compile(
+    r"`make robot NAME=(\S+) URDF=(\S+) TIP=(\S+)(?: BASE=(\S+))? TOOL_MASS=(\S+?)(?: DRIVER=(\S+))?`"
+)
+
+
+def recorded_command(readme: str) -> RobotSpec | None:
+    """The `make robot` command a generated package's README records (None: not generated)."""
+    match = _COMMAND.search(readme)
+    if not match:
+        return None
+    name, urdf, tip, base, mass, driver = match.groups()
+    return RobotSpec(name, urdf, tip, base or "", float(mass), driver or "")
 
 
 @dataclass(frozen=True)
@@ -98,6 +141,7 @@ class Plan:
     kv: tuple[float, ...]
     armature: float
     efforts: tuple[float, ...]
+    driver: DriverInterface  # the hardware files' driver (generic, or from the DRIVER profile)
 
 
 def _source(urdf: str) -> tuple[str, str]:
@@ -159,6 +203,10 @@ def plan_robot(spec: RobotSpec, log=print) -> Plan:
         raise GeneratorError(f"NAME={spec.name!r}: use lower-case letters, digits and _ (a ROS package name)")
     if not spec.tool_mass > 0:
         raise GeneratorError(f"TOOL_MASS={spec.tool_mass}: must be positive [kg]")
+    try:  # before the measuring: a bad DRIVER is named at once
+        driver = driver_interface(spec.driver)
+    except DriverError as exc:
+        raise GeneratorError(str(exc)) from exc
     source, stock = _source(spec.urdf)
     root, children = _tree(stock)
     links = {lnk.get("name", "") for lnk in ET.fromstring(stock).findall("link")}
@@ -170,9 +218,16 @@ def plan_robot(spec: RobotSpec, log=print) -> Plan:
     removed = tuple(child for child, _, _ in children.get(spec.tip, []))
     tool = ToolSpec(parent=spec.tip, mass=spec.tool_mass, com=TOOL_COM, size=TOOL_SIZE)
     urdf_xml = build_description(stock, tool, removed)
+    missing = driver.missing_links({lnk.get("name", "") for lnk in ET.fromstring(urdf_xml).findall("link")})
+    if missing:
+        raise GeneratorError(
+            f"DRIVER={spec.driver}: the profile's frames are not in the {name} description (the emulated "
+            f"driver would refuse it): {'; '.join(missing)}"
+        )
     arm = ArmModel(urdf_xml, tool.tip_name)
     reach = estimate_reach(arm)
     log(f"[robot] {spec.name}: {arm.nv} joints {list(arm.joint_names)}, tool-tip reach ~{reach:.2f} m")
+    log(f"[robot] {driver.summary()}")
     scale = min(1.0, reach / REFERENCE_REACH)
     gap = _round(max(0.04, 0.07 * scale), 0.005)
     geometry = DemoGeometry(
@@ -225,7 +280,7 @@ def plan_robot(spec: RobotSpec, log=print) -> Plan:
         spec=spec, source=source, removed=removed, base=base, urdf_xml=urdf_xml, joints=arm.joint_names,
         reach=reach, geometry=geometry, gap=gap, obstacle_size=obstacle_size,
         obstacle_position=obstacle_position, start=start, home=home, threshold=threshold, hard_stop=hard_stop,
-        kp=kp, kv=kv, armature=armature, efforts=tuple(efforts),
+        kp=kp, kv=kv, armature=armature, efforts=tuple(efforts), driver=driver,
     )
     for line in analysis_lines(plan, arm):
         log(f"[robot] {line}")
@@ -294,9 +349,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--tip", required=True, help="flange link the F/T sensor and tool go on")
     parser.add_argument("--base", default="", help="base frame (default: the URDF root)")
     parser.add_argument("--tool-mass", type=float, default=1.0, help="tool mass [kg] (default 1.0)")
+    parser.add_argument(
+        "--driver", default="", help="the real driver the hardware files are for: a mujoco_driver profile "
+        "name (ur_robot_driver, franka_ros) or YAML path (default: a generic ros_control driver)"
+    )
     parser.add_argument("--src", default=os.path.join(os.getcwd(), "src"), help="workspace src/ directory")
     args = parser.parse_args(argv)
-    spec = RobotSpec(args.name, args.urdf, args.tip, args.base, args.tool_mass)
+    spec = RobotSpec(args.name, args.urdf, args.tip, args.base, args.tool_mass, args.driver)
     try:
         plan = plan_robot(spec)
     except (GeneratorError, DescriptionError) as exc:
