@@ -110,3 +110,27 @@ def test_file_limits_default_to_the_declared_parameters():
     poses = NamedPoses.from_dict({"poses": {"a": {"j": 0.0}}}, urdf)
     assert poses.max_velocity[0] == PARAMETERS["max_velocity"].default
     assert poses.max_acceleration[0] == PARAMETERS["max_acceleration"].default
+
+
+def test_the_trajectory_controller_is_switched_on_stopping_only_the_ones_on_its_joints():
+    from named_poses.switching import Controller, Switch, SwitchError, controller_of, plan_switch
+
+    arm = frozenset({"j1", "j2"})
+    listing = [
+        Controller("joint_state_controller", "running", frozenset()),
+        Controller("scaled_pos_joint_traj_controller", "stopped", arm),
+        Controller("joint_group_vel_controller", "running", arm),
+        Controller("gripper_controller", "running", frozenset({"finger"})),
+    ]
+    assert controller_of("scaled_pos_joint_traj_controller/command") == "scaled_pos_joint_traj_controller"
+    assert controller_of("/ns/arm_controller/command") == "arm_controller"
+    assert controller_of("joint_trajectory") == ""
+    switch = plan_switch(listing, "scaled_pos_joint_traj_controller")
+    assert switch == Switch(start=("scaled_pos_joint_traj_controller",), stop=("joint_group_vel_controller",))
+    assert switch.undo() == Switch(
+        start=("joint_group_vel_controller",), stop=("scaled_pos_joint_traj_controller",)
+    )
+    running = [Controller("arm_controller", "running", arm)]
+    assert plan_switch(running, "arm_controller") is None
+    with pytest.raises(SwitchError, match=r"'arm_ctrl' is not loaded .*\['arm_controller'\]"):
+        plan_switch(running, "arm_ctrl")

@@ -32,7 +32,7 @@ import actionlib
 from cartesian_impedance_msgs.msg import ControlLaw
 from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
 from compliant_control_msgs.msg import ContactControlStatus
-from compliant_control_msgs.srv import PushEEF, PushEEFRequest
+from compliant_control_msgs.srv import MoveToNamedPose, PushEEF, PushEEFRequest
 from controller_manager_msgs.srv import ListControllers, SwitchController, SwitchControllerRequest
 from driver_emulation_msgs.msg import ErrorRecoveryAction, ErrorRecoveryGoal
 from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
@@ -173,6 +173,20 @@ def _switch_on_jog_controller(rospy, driver, twist_pub, pose: Collector, base: s
     return f"switched {name} on, stopping {', '.join(stop) or 'nothing'}"
 
 
+def _named_pose_round_trip(rospy, profile: DriverProfile | None) -> str:
+    """`/named_poses/move_to` home and back to start while jog_arm's controller runs: named_poses switches
+    its trajectory controller on for each move if it is not running and back afterwards, so the controller
+    states are as before (the jog that follows proves jog_arm's controller runs again)."""
+    before = _controller_states(rospy, profile) if profile is not None else {}
+    move_to = rospy.ServiceProxy("/named_poses/move_to", MoveToNamedPose)
+    answers = [move_to(name=name, speed_scale=1.0) for name in ("home", "start")]
+    for answer in answers:
+        assert answer.success, answer.message
+    if profile is not None:
+        assert _controller_states(rospy, profile) == before, "named_poses left the controllers switched"
+    return "switched" if "switched" in answers[0].message else "no switch"
+
+
 def _driver_extras(rospy, profile: DriverProfile, wrench: WrenchStamped) -> None:
     """What the profile promises beyond topics: the speed scaling at 1.0, a payload-compensated wrench that
     reads no tool weight at rest, the zero service."""
@@ -206,6 +220,8 @@ def _jog_and_push(rospy, robot: str, cell: dict, profile: DriverProfile | None, 
     if profile is not None:
         _driver_extras(rospy, profile, wrench)
         switched = _switch_on_jog_controller(rospy, driver, twist_pub, pose, cell["base"], robot, profile)
+    named = _named_pose_round_trip(rospy, profile)
+    switched += f"; named poses: {named}"
     zeroed = lambda: cc_status.last().safety == ContactControlStatus.SAFETY_OK  # noqa: E731
     wait_until(zeroed, 20, "contact_control to zero the sensor")
     moved = _jog(rospy, twist_pub, pose, cell["base"], distance=0.02, proc=driver.proc)

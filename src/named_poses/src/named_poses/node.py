@@ -10,18 +10,21 @@ from __future__ import annotations
 
 import threading
 import time
+from typing import NamedTuple
 
 import numpy as np
 import rospy
 import yaml
 from compliant_control_msgs.msg import ContactControlStatus
 from compliant_control_msgs.srv import MoveToNamedPose, MoveToNamedPoseResponse
+from controller_manager_msgs.srv import ListControllers, SwitchController, SwitchControllerRequest
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from named_poses.params import FILE_KEYS, load_settings
 from named_poses.poses import NamedPoses, PoseError, urdf_joints
 from named_poses.profile import ProfileError, plan_move
+from named_poses.switching import Controller, Switch, SwitchError, controller_of, plan_switch
 
 __all__ = ["NamedPoseServer", "main"]
 
@@ -59,6 +62,8 @@ class NamedPoseServer:
             tcp_nodelay=True,
         )
         self._states_topic = rospy.resolve_name(settings.joint_states_topic)
+        self._controller = controller_of(settings.trajectory_topic)
+        self._manager = rospy.resolve_name(settings.controller_manager) if settings.controller_manager else ""
         rospy.Subscriber(settings.joint_states_topic, JointState, self._on_joints,
                          queue_size=1, tcp_nodelay=True)
         rospy.Subscriber(settings.contact_control_status,
@@ -141,20 +146,91 @@ class NamedPoseServer:
             msg.points.append(JointTrajectoryPoint(
                 positions=q.tolist(), velocities=v.tolist(), time_from_start=rospy.Duration.from_sec(float(t))
             ))
+        switch = None
         if move.duration > 0.0:
+            try:
+                switch = self._switch_on()
+            except SwitchError as exc:
+                return self._refuse(str(exc))
+        back = _Switched(True, "")
+        try:
+            answer = self._move(req.name, goal, move.duration, msg)
+        finally:
+            if switch is not None:
+                back = self._switch(switch.undo())
+        if switch is not None:
+            note = f"; switched {list(switch.start)} on for the move (stopping {list(switch.stop)})"
+            answer.message += note + (", then back" if back else f"; switching back failed: {back.reason}")
+        return answer
+
+    def _move(
+        self, name: str, goal: np.ndarray, duration: float, msg: JointTrajectory
+    ) -> MoveToNamedPoseResponse:
+        """Sends the trajectory and waits for the arm to arrive."""
+        if duration > 0.0:
             self._pub.publish(msg)  # stamp 0: the driver starts it now
-        rospy.loginfo("named_pose_server: to %r in %.2f s", req.name, move.duration)
-        deadline = time.monotonic() + move.duration + self.settle_time
+        rospy.loginfo("named_pose_server: to %r in %.2f s", name, duration)
+        deadline = time.monotonic() + duration + self.settle_time
         while time.monotonic() < deadline and not rospy.is_shutdown():
             now = self._current()
             if now is not None and float(np.max(np.abs(now - goal))) <= self.tolerance:
                 return MoveToNamedPoseResponse(
-                    success=True, message=f"at {req.name!r} after a {move.duration:.2f} s move"
+                    success=True, message=f"at {name!r} after a {duration:.2f} s move"
                 )
             time.sleep(0.01)
         now = self._current()
         error = float(np.max(np.abs(now - goal))) if now is not None else float("nan")
-        return self._refuse(f"did not reach {req.name!r}: largest joint error {error:.3f} rad")
+        return self._refuse(f"did not reach {name!r}: largest joint error {error:.3f} rad")
+
+    # --- controller switching (switching.py; README, Controller switching) ---
+    def _switch_on(self) -> Switch | None:
+        """Switches the trajectory controller on if a controller manager runs it stopped; the switch made.
+
+        Raises:
+            SwitchError: It cannot run (not loaded, or the switch was refused).
+        """
+        if not self._controller or not self._manager:
+            return None
+        try:
+            rospy.wait_for_service(self._manager + "/list_controllers", timeout=0.3)
+        except rospy.ROSException:
+            return None  # no controller manager (a driver without ros_control): nothing to switch
+        try:
+            listing = rospy.ServiceProxy(self._manager + "/list_controllers", ListControllers)()
+        except (rospy.ServiceException, rospy.ROSException) as exc:
+            raise SwitchError(f"{self._manager}/list_controllers failed: {exc}") from exc
+        claims = {c.name: frozenset(r for claim in c.claimed_resources for r in claim.resources)
+                  for c in listing.controller}
+        switch = plan_switch(
+            (Controller(c.name, c.state, claims[c.name]) for c in listing.controller), self._controller,
+        )
+        if switch is not None:
+            result = self._switch(switch)
+            if not result:
+                raise SwitchError(f"could not switch {self._controller} on: {result.reason}")
+        return switch
+
+    def _switch(self, switch: Switch) -> _Switched:
+        request = SwitchControllerRequest(
+            start_controllers=list(switch.start), stop_controllers=list(switch.stop),
+            strictness=SwitchControllerRequest.STRICT,
+        )
+        try:
+            ok = rospy.ServiceProxy(self._manager + "/switch_controller", SwitchController)(request).ok
+        except (rospy.ServiceException, rospy.ROSException) as exc:
+            return _Switched(False, f"{self._manager}/switch_controller failed: {exc}")
+        rospy.loginfo("named_pose_server: switch_controller start %s stop %s: %s",
+                      list(switch.start), list(switch.stop), "ok" if ok else "refused")
+        return _Switched(ok, "" if ok else f"switch_controller start {list(switch.start)} stop "
+                         f"{list(switch.stop)} refused")
+
+
+class _Switched(NamedTuple):
+    ok: bool
+    reason: str
+
+    def __bool__(self) -> bool:
+        return self.ok
 
 
 def main() -> int:

@@ -55,6 +55,12 @@ class NamedPoseSettings:
         "arm_controller/command", nonempty=True, doc="trajectory_msgs/JointTrajectory output (the driver's)"
     )
     joint_states_topic: str = param("joint_states", nonempty=True, doc="sensor_msgs/JointState input")
+    controller_manager: str = param(
+        "controller_manager",
+        doc="a ros_control controller manager's namespace: if it serves list_controllers and the controller "
+        "of `trajectory_topic` (`<controller>/command`) is not running, a move switches it on, stopping the "
+        "running controllers that claim its joints, and switches back afterwards; empty: never switch",
+    )
     contact_control_status: str = param(
         "/contact_control_node/status", nonempty=True,
         doc="compliant_control_msgs/ContactControlStatus input: no move while a contact move runs",
