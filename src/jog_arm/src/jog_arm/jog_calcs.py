@@ -17,7 +17,7 @@ Pipeline of :meth:`JogCalcs.step` (all arrays preallocated, model and data built
    sideways while the Jacobian changes.)
 5b. Straightening: a joint step of more than 1 mrad per period (slow output rates: a trajectory every
    50 ms) moves the tip on a curve; one Newton step puts the step's end where the twist would take the tip.
-   Together with 5, a 20 Hz Panda follower's sideways drift over 15 cm fell from 5.2 mm to 0.00 mm.
+   Together with 5, a 20 Hz 7-joint follower's sideways drift over 15 cm fell from 5.2 mm to 0.00 mm.
 6. Joint position limits (ramp down before the margin, stop at it, braking within the acceleration
    limit; moving away always allowed), then velocity limits, then acceleration limits: each scales the
    WHOLE vector, never one joint.
@@ -54,6 +54,7 @@ _EIGENVALUES_ONLY = eigenpy.DecompositionOptions.EigenvaluesOnly
 _DAMPING_FLOOR = 1e-12
 # [rad] a joint step above this per period bends the tip's path enough to straighten (module docstring, 7.)
 _STRAIGHTEN_STEP = 1e-3
+_STRAIGHTEN_LIMIT = 0.1  # a correction above this fraction of the velocity is not applied
 
 
 @dataclass(frozen=True)
@@ -167,6 +168,8 @@ class JogCalcs:
         self._to_user_list = self._to_user.tolist()
         self._identity_order = self._to_user_list == list(range(n))
         self._period = settings.pub_period
+        # With publish_on_command a step lasts until the next twist, not pub_period: nothing to straighten.
+        self._straighten_step = math.inf if settings.publish_on_command else _STRAIGHTEN_STEP
         self.limiter = JointLimiter(
             self.model.lower,
             self.model.upper,
@@ -537,7 +540,7 @@ class JogCalcs:
             )
         # 5. Low-pass filter on the scaled twist (root axes), started from the twist of the current output so
         # there is no start-up jump. Filtering joint velocities instead blends J⁺ of past configurations,
-        # which moves the tip sideways while the Jacobian changes (2 mm over 15 cm on a 20 Hz Panda follower).
+        # which moves the tip sideways while the Jacobian changes (2 mm over 15 cm at 20 Hz, 7 joints).
         if not self._filter_live:
             self._filter.reset((J @ np.asarray(self._dq_out)).tolist())
             self._filter_live = True
@@ -586,11 +589,11 @@ class JogCalcs:
 
     def _straighten(self, q_ref: list[float], dq: list[float]) -> list[float]:
         """The joint velocity whose straight step over the period ends where the twist J(q_ref)·dq, held that
-        long, takes the tip: a straight step in joint space moves the tip on a curve (at 20 Hz a Panda
+        long, takes the tip: a straight step in joint space moves the tip on a curve (at 20 Hz a 7-joint
         follower drifted 3.6 mm sideways over 15 cm). One Newton step with the damped pseudo-inverse at
         `q_ref`; a correction of second order (a few percent of the step), before the limits."""
         period = self._period
-        if max(map(abs, dq)) * period <= _STRAIGHTEN_STEP:
+        if max(map(abs, dq)) * period <= self._straighten_step:
             return dq
         g = self._geometry(q_ref)
         dq_arr = np.asarray(dq)
@@ -598,7 +601,10 @@ class JogCalcs:
         error = self.model.tip_displacement(g.q_arr, q_end, self._displacement)
         error[:3] *= self._inv_length
         error -= g.J @ dq_arr * period
-        dq_arr -= (g.J.T @ self._llt.solve(error)) / period
+        correction = (g.J.T @ self._llt.solve(error)) / period
+        if np.max(np.abs(correction)) > _STRAIGHTEN_LIMIT * np.max(np.abs(dq_arr)):
+            return dq  # not second order: a step too long for one Newton step to be right
+        dq_arr -= correction
         return dq_arr.tolist()
 
     def prefetch(self) -> None:

@@ -351,7 +351,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--tool-mass", type=float, default=1.0, help="tool mass [kg] (default 1.0)")
     parser.add_argument(
         "--driver", default="", help="the real driver the hardware files are for: a mujoco_driver profile "
-        "name (ur_robot_driver, franka_ros) or YAML path (default: a generic ros_control driver)"
+        "name (one in mujoco_driver config/profiles) or YAML path (default: a generic ros_control driver)"
     )
     parser.add_argument("--src", default=os.path.join(os.getcwd(), "src"), help="workspace src/ directory")
     args = parser.parse_args(argv)
