@@ -327,3 +327,55 @@ def test_publish_on_command_answers_every_twist_without_waiting_for_the_timer(ro
         commands.wait_for(20, timeout=5)  # ~50 per second, where the 2 s timer alone gives 2 or 3
         v = eef_velocity(ArmModel(UR5.urdf, UR5.tip), UR5.start, commands.last().data)
         assert v[2] > 0.0 and abs(v[0]) < 0.2 * v[2] and abs(v[1]) < 0.2 * v[2]
+
+
+def test_contact_controls_twists_pass_the_guard_and_others_do_not(ros_node) -> None:
+    """Two-node layout: contact_control's twists reach jog_arm on the same topic as a keyboard's. At 25 N
+    (over the 20 N guard limit) a keyboard twist into the contact becomes a retreat, but the exempt node's
+    (by its caller id) passes: its laws react to the force themselves (a compliant move's move_away, a
+    force-tracking press). Before, the guard slowed contact_control's own moves from 2 N on."""
+    import subprocess
+
+    from geometry_msgs.msg import WrenchStamped
+    from std_msgs.msg import Float64MultiArray
+
+    rospy = ros_node
+    params = {
+        "command_out_type": "velocity_array", "integrate_from": "measured",
+        "contact_guard_wrench_topic": "/jog_guard/contact", "contact_guard_exempt": [rospy.get_name()],
+    }
+    contact = rospy.Publisher("/jog_guard/contact", WrenchStamped, queue_size=1)
+    press = WrenchStamped()
+    press.header.frame_id = UR5.planning_frame
+    press.wrench.force.z = 25.0  # the surface pushes the tool up
+    pressing = Repeater(contact).start(press, rate=100.0)
+    model = ArmModel(UR5.urdf, UR5.tip)
+
+    def vz() -> float:
+        return float(eef_velocity(model, UR5.start, commands.last().data)[2])
+
+    try:
+        with ur5_server(rospy, "jog_test_guard", "/jog_guard", params, Float64MultiArray) as (
+            commands,
+            sender,
+        ):
+            commands.wait_connected()
+            # Exempt (this node): down into the contact as asked.
+            sender.start(twist_msg((0.0, 0.0, -0.02, 0.0, 0.0, 0.0)), rate=50.0)
+            commands.wait_for(10, timeout=5)
+            wait_until(lambda: vz() < -0.015, 5, "the exempt twist to move down")
+            sender.stop()
+            # Another node (rostopic pub): the same twist is guarded into a retreat.
+            keyboard = subprocess.Popen(
+                ["rostopic", "pub", "-r", "50", "/jog_guard/twist", "geometry_msgs/TwistStamped",
+                 "{twist: {linear: {z: -0.02}}}", "__name:=keyboard"],
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
+            )
+            try:
+                wait_until(lambda: 0.0 < vz() <= 0.0051, 10, "the guarded twist to back off at 5 mm/s")
+            finally:
+                keyboard.terminate()
+                keyboard.wait(10)
+    finally:
+        pressing.stop()
+        contact.unregister()

@@ -48,6 +48,8 @@ class JogArmNode:
         if settings.contact_guard_enabled:  # the force from contact_control_node's ~contact_wrench
             self._subs.append(rospy.Subscriber(settings.contact_guard_wrench_topic, WrenchStamped,
                                                self._on_contact_wrench, **fast))
+        # Publishers whose twists pass unguarded, told apart by the caller id rospy keeps with each message.
+        self._exempt = frozenset(rospy.resolve_name(name) for name in settings.contact_guard_exempt)
         start_ticker(self._tick, settings.pub_period, "jog_arm_cycles")
 
     def _now(self) -> float:
@@ -70,9 +72,11 @@ class JogArmNode:
     def _on_twist(self, msg: TwistStamped) -> None:
         lin, ang = msg.twist.linear, msg.twist.angular
         self.ros.ensure_frame(msg.header.frame_id)
+        header = getattr(msg, "_connection_header", None) or {}
+        guarded = header.get("callerid") not in self._exempt
         with self._lock:
             cycle = self.stage.on_twist((lin.x, lin.y, lin.z, ang.x, ang.y, ang.z), msg.header.frame_id,
-                                        self._now())
+                                        self._now(), guarded=guarded)
             self.ros.publish(cycle)
             self.ros.log_notes()
             if cycle is not None and cycle.publish:

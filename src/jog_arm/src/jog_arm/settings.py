@@ -204,6 +204,11 @@ class JogSettings:
     contact_guard_wrench_topic: str = param(
         "contact_control_node/contact_wrench", doc="two-node layout: where the contact force comes from"
     )
+    contact_guard_exempt: tuple[str, ...] = param(
+        ("contact_control_node",), type="strings",
+        doc="two-node layout: nodes whose twists on `cmd_in_topic` pass unguarded (contact_control: its laws "
+        "react to the force themselves); relative names resolve in jog_arm's namespace",
+    )
 
     @classmethod
     def from_params(cls, params: Mapping[str, Any], prefix: str = "jog_arm_server/") -> JogSettings:

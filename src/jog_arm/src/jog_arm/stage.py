@@ -134,20 +134,22 @@ class JogStage:
         self._contact = (force, frame, t)
 
     def on_twist(
-        self, twist: Sequence[float], frame: str, t: float, outside: bool = True
+        self, twist: Sequence[float], frame: str, t: float, outside: bool = True, guarded: bool | None = None
     ) -> JogCycle | None:
         """A velocity command (vx, vy, vz, wx, wy, wz) in `frame` ("": the default) received at `t` [s].
 
         Args:
             outside: From a topic (keyboard, GUI): it passes the contact guard and is dropped when its
                 publisher disconnects. False: from the controller in the same pipeline.
+            guarded: Whether it passes the contact guard (None: if `outside`); False for contact_control's
+                twists over the topic in the two-node layout (its laws react to the force themselves).
 
         Returns:
             The cycle it ran (publish_on_command), else None. A refused command is noted for the log and
             makes the arm stop (see `JogCalcs.set_command`).
         """
         frame = frame.lstrip("/")
-        if outside and self.guard is not None:
+        if (outside if guarded is None else guarded) and self.guard is not None:
             twist = self._guarded(twist, frame or self.settings.default_cmd_frame, t)
         result = self.jog.set_command(twist, frame, t)
         self._from_topic = outside
