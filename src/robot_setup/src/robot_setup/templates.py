@@ -325,40 +325,17 @@ low_pass_filter_coeff: 2.5
 </launch>
 """
     if d.generic:
-        files["launch/hardware.launch"] = f"""<?xml version="1.0"?>
-<!--
-  {name} compliant-control stack against a real robot (written by make robot for a generic ros_control
+        header = f"""  {name} compliant-control stack against a real robot (written by make robot for a generic ros_control
   driver; not run on a real arm, but run unchanged against `roslaunch mujoco_driver emulated_robot.launch
   robot_package:={name}_custom`, tests/robot_packages/test_robot_emulated_drivers.py). Start the robot's
   driver first with a joint_trajectory_controller on {TRAJECTORY_TOPIC} and a wrist F/T sensor driver
   publishing WrenchStamped on `wrench`; set other topics in config/*_hardware.yaml.
--->
-<launch>
-  <arg name="load_description" default="true" doc="load robot_description (false if the driver's launch loads one that has ft_sensor and tool_tip)"/>
-  <arg name="with_state_publisher" default="true" doc="start robot_state_publisher for this description"/>
-  <arg name="with_jog_arm" default="true" doc="start jog_arm_server"/>
-  <arg name="with_contact_control" default="true" doc="start contact_control_node"/>
-  <arg name="with_named_poses" default="true" doc="start named_poses (move_to a pose of config/named_poses.yaml)"/>
-  <arg name="output" default="screen" doc="screen or log"/>
-
-  <include file="$(find mujoco_driver)/launch/inc/control_stack.launch.xml">
-    <arg name="description_args" value="$(find {pkg})/config/description.args"/>
-    <arg name="jog_arm_config" value="$(find {pkg})/config/jog_arm_hardware.yaml"/>
-    <arg name="contact_control_config" value="$(find {pkg})/config/contact_control_hardware.yaml"/>
-    <arg name="load_description" value="$(arg load_description)"/>
-    <arg name="with_state_publisher" value="$(arg with_state_publisher)"/>
-    <arg name="with_jog_arm" value="$(arg with_jog_arm)"/>
-    <arg name="with_contact_control" value="$(arg with_contact_control)"/>
-    <arg name="output" value="$(arg output)"/>
-  </include>
-
-  <include if="$(arg with_named_poses)" file="$(find named_poses)/launch/named_poses.launch">
-    <arg name="config" value="$(find {pkg})/config/named_poses.yaml"/>
-    <arg name="trajectory_topic" value="{TRAJECTORY_TOPIC}"/>
-    <arg name="output" value="$(arg output)"/>
-  </include>
-</launch>
 """
+        files["launch/hardware.launch"] = _launch_file(
+            pkg, header, "start robot_state_publisher for this description", "", "", {
+                "trajectory_topic": TRAJECTORY_TOPIC,
+            },
+        )
     else:
         files["launch/hardware.launch"] = _hardware_launch(plan, command_line(plan.spec))
     files["launch/keyboard.launch"] = f"""<?xml version="1.0"?>
@@ -575,12 +552,29 @@ def _hardware_launch(plan: Plan, command: str) -> str:
         "launch runs its own robot_state_publisher on the stock URDF, give it this description instead and pass "
         "with_state_publisher:=false, or the arm's links get two tf publishers.",
     ))
+    named_poses = f"""
+  <!-- Named poses (config/named_poses.yaml): /named_poses/move_to through the trajectory controller
+       ({d.trajectory_topic}), switched on for each move if it is not running (named_poses README). -->"""
+    return _launch_file(
+        pkg, header,
+        "start robot_state_publisher for this description (false if the driver's launch publishes tf from it)",
+        remap, named_poses,
+        {"trajectory_topic": d.trajectory_topic, "joint_states_topic": d.joint_states_topic},
+    )
+
+
+def _launch_file(
+    pkg: str, header: str, state_publisher_doc: str, remap: str, named_poses_comment: str, named_poses: dict[str, str]
+) -> str:
+    """hardware.launch: `header` (comment lines), the stack on the package's hardware YAML, named_poses with
+    the `named_poses` args (a generic driver and a profile's driver differ only in these)."""
+    args = "".join(f'\n    <arg name="{key}" value="{value}"/>' for key, value in named_poses.items())
     return f"""<?xml version="1.0"?>
 <!--
 {header}-->
 <launch>
   <arg name="load_description" default="true" doc="load robot_description (false if the driver's launch loads one that has ft_sensor and tool_tip)"/>
-  <arg name="with_state_publisher" default="true" doc="start robot_state_publisher for this description (false if the driver's launch publishes tf from it)"/>
+  <arg name="with_state_publisher" default="true" doc="{state_publisher_doc}"/>
   <arg name="with_jog_arm" default="true" doc="start jog_arm_server"/>
   <arg name="with_contact_control" default="true" doc="start contact_control_node"/>
   <arg name="with_named_poses" default="true" doc="start named_poses (move_to a pose of config/named_poses.yaml)"/>
@@ -596,13 +590,9 @@ def _hardware_launch(plan: Plan, command: str) -> str:
     <arg name="with_contact_control" value="$(arg with_contact_control)"/>
     <arg name="output" value="$(arg output)"/>
   </include>
-
-  <!-- Named poses (config/named_poses.yaml): /named_poses/move_to through the trajectory controller
-       ({d.trajectory_topic}, which must be running for it). -->
+{named_poses_comment}
   <include if="$(arg with_named_poses)" file="$(find named_poses)/launch/named_poses.launch">
-    <arg name="config" value="$(find {pkg})/config/named_poses.yaml"/>
-    <arg name="trajectory_topic" value="{d.trajectory_topic}"/>
-    <arg name="joint_states_topic" value="{d.joint_states_topic}"/>
+    <arg name="config" value="$(find {pkg})/config/named_poses.yaml"/>{args}
     <arg name="output" value="$(arg output)"/>
   </include>
 </launch>
