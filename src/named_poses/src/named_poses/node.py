@@ -13,6 +13,7 @@ import time
 from typing import NamedTuple
 
 import numpy as np
+import rosgraph
 import rospy
 import yaml
 from compliant_control_msgs.msg import ContactControlStatus
@@ -191,9 +192,9 @@ class NamedPoseServer:
         """
         if not self._controller or not self._manager:
             return None
-        try:
-            rospy.wait_for_service(self._manager + "/list_controllers", timeout=0.3)
-        except rospy.ROSException:
+        try:  # asked of the master, no waiting: a move without a controller manager pays nothing
+            rosgraph.Master(rospy.get_name()).lookupService(self._manager + "/list_controllers")
+        except (rosgraph.MasterException, OSError):
             return None  # no controller manager (a driver without ros_control): nothing to switch
         try:
             listing = rospy.ServiceProxy(self._manager + "/list_controllers", ListControllers)()
