@@ -62,7 +62,10 @@ def _cell(robot: str, profile: str, joints: str):
     with run_launch("mujoco_driver", "emulated_robot.launch", args=args) as driver:
         driver.wait_for_topic(joints, timeout=40)
         with run_launch(robot, "hardware.launch") as stack:
-            stack.wait_for_service("/configure_cartesian_impedance", timeout=40)
+            # named_poses is a node of its own: its service comes up on its own schedule (CI once called
+            # move_to before it was advertised: "no provider").
+            for service in ("/configure_cartesian_impedance", "/named_poses/move_to"):
+                stack.wait_for_service(service, timeout=40)
             stack.wait_for_topic("/contact_control_node/status", timeout=40)
             yield driver, stack
             stack.stop()
@@ -196,6 +199,7 @@ def _driver_extras(rospy, profile: DriverProfile, wrench: WrenchStamped) -> None
         f = wrench.wrench.force
         assert np.linalg.norm([f.x, f.y, f.z]) < 0.5, f"payload not compensated: {f}"
     if profile.wrench.zero_service:
+        rospy.wait_for_service(f"/{profile.wrench.zero_service}", timeout=10)
         assert rospy.ServiceProxy(f"/{profile.wrench.zero_service}", Trigger)().success
 
 
