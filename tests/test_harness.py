@@ -1,5 +1,6 @@
 """The test harness itself: private master, real topics, launch helpers and bags."""
 
+import pathlib
 import subprocess
 
 import pytest
@@ -102,3 +103,16 @@ def test_launch_waits_report_a_missing_topic(ros_node):
 
 def test_roslaunch_is_available():
     assert subprocess.run(["roslaunch", "--help"], capture_output=True).returncode == 0
+
+
+def test_with_env_passes_the_command_its_own_arguments():
+    """`scripts/with_env CMD --help`: catkin's setup script must not see (and choke on) the command's
+    arguments; the command gets them all, unchanged, and runs in the built workspace."""
+    root = pathlib.Path(__file__).resolve().parents[1]
+    script = 'printf "%s|" "$@"; echo "$ROS_PACKAGE_PATH"'
+    command = [str(root / "scripts/with_env"), "bash", "-c", script, "cmd", "--help", "--extend", "a b"]
+    out = subprocess.run(command, capture_output=True, text=True, check=True, timeout=30)
+    args, package_path = out.stdout.strip().split("\n")[-1].rsplit("|", 1)
+    assert args == "--help|--extend|a b"
+    assert str(root / "src") in package_path
+    assert out.stderr == ""
