@@ -3,6 +3,8 @@ SHELL := /bin/bash
 .SHELLFLAGS := -o pipefail -c
 ROBOT ?= ur5
 DRIVER ?=
+DRIVER_OPTIONS ?=
+BAG ?=
 ENV := scripts/with_env
 PYTEST_ARGS ?=
 
@@ -27,7 +29,8 @@ param-tables: build
 	@$(ENV) python -m compliant_common.schema_docs --write
 
 demo: build
-	@$(ENV) python scripts/demo --robot $(ROBOT) $(if $(DRIVER),--driver $(DRIVER))
+	@$(ENV) python scripts/demo --robot $(ROBOT) $(if $(DRIVER),--driver $(DRIVER)) \
+		$(if $(DRIVER_OPTIONS),--driver-options "$(DRIVER_OPTIONS)") $(if $(BAG),--bag)
 
 # make robot NAME=<name> URDF=<path, or relative to example-robot-data's robots/> TIP=<flange link>
 #   [BASE=<link>] [TOOL_MASS=<kg>] [DRIVER=<mujoco_driver profile name or YAML path>]: writes

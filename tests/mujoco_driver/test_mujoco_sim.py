@@ -254,6 +254,41 @@ def test_tool_meets_the_obstacle_when_driven_down(robot, sim):
     assert sim.warnings() == {}
 
 
+def test_a_tool_pressed_on_the_block_slides_over_it_without_hopping(robot, sim):
+    """Surface following's physics: the tool pressed on the block's top with 10 N (a force loop at every step,
+    b = 2000 N/(m/s)) while it slides 1 cm/s along -X keeps its contact: every sample of the force within
+    10 +- 1.5 N. With MuJoCo's default contact impedance it hopped at ~70 Hz (one-step dips to 2.6 N) and
+    a 125 Hz driver's samples aliased that into 6-12 N means."""
+    model = robot.pin_model
+    data = model.createData()
+    tip = model.getFrameId(robot.cfg.links.eef)
+    weight = tool_weight(sim)[2]
+    twist = np.zeros(6)
+    touched, forces = None, []
+    while sim.time < 10.0:
+        force = world_wrench(sim)[0][2] - weight  # the block pushes the tool up (+Z)
+        if touched is None and force > 3.0 and sim.time > 0.5:
+            touched = sim.time
+        twist[2] = -0.02 if touched is None else max(-0.02, (force - 10.0) / 2000.0)
+        twist[0] = -0.01 if touched is not None and sim.time > touched + 1.5 else 0.0
+        if touched is not None and sim.time > touched + 2.0:
+            forces.append(force)
+        if len(forces) >= round(1.5 / sim.dt):
+            break
+        jac = pin.computeFrameJacobian(model, data, sim.qpos, tip, pin.LOCAL_WORLD_ALIGNED)
+        sim.set_velocity_targets(np.linalg.lstsq(jac, twist, rcond=None)[0])
+        sim.step()
+    assert touched is not None, "the tool never touched the block"
+    forces = np.array(forces)
+    assert len(forces) == round(1.5 / sim.dt), "the slide did not finish"
+    assert np.mean(forces) == pytest.approx(10.0, abs=0.5)
+    assert forces.min() > 8.5 and forces.max() < 11.5, (
+        f"the contact force left 10 +- 1.5 N while sliding: {forces.min():.2f}..{forces.max():.2f} N, "
+        f"{np.sum(np.abs(forces - 10.0) > 1.5)} of {len(forces)} samples")
+    assert "obstacle" in sim.tool_contacts()
+    assert sim.warnings() == {}
+
+
 def test_reset_returns_to_the_start_pose(sim):
     qd = np.zeros(len(sim.joint_names))
     qd[1] = 0.3

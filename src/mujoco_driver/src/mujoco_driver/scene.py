@@ -222,6 +222,14 @@ def _subtree(root: mujoco.MjsBody) -> list[mujoco.MjsBody]:
     return bodies
 
 
+# The block's contact impedance (MuJoCo solimp: dmin, dmax, width [m], midpoint, power). With MuJoCo's default
+# (0.9, 0.95, 0.001) a flat tool face sliding over the block's top at 10 N hopped at ~70 Hz: its contacts
+# vanished every 7 steps and the force fell to 2.6 N for one step (raw std 2.8 N), which a 125 Hz driver's
+# samples alias into 6-12 N means. Starting softer (0.5) over 5 mm keeps the tool in contact while it slides
+# (std 0.05-0.2 N) and still makes a stiff block: ~150 N/mm at the tool tip, 0.2 mm deep at 20 N (README).
+OBSTACLE_SOLIMP = [0.5, 0.95, 0.005, 0.5, 2.0]
+
+
 def _add_environment(spec: mujoco.MjSpec, cfg: SceneConfig) -> None:
     world, table = spec.worldbody, cfg.table
     world.add_light(name="sun", pos=[0.0, 0.0, 3.0], dir=[0.0, 0.0, -1.0])
@@ -232,8 +240,9 @@ def _add_environment(spec: mujoco.MjSpec, cfg: SceneConfig) -> None:
                    pos=[table.center[0], table.center[1], -table.thickness / 2], rgba=[0.6, 0.45, 0.3, 1.0])
     if cfg.obstacle is not None:
         obs = cfg.obstacle
-        world.add_geom(name="obstacle", type=mujoco.mjtGeom.mjGEOM_BOX, size=[s / 2 for s in obs.size],
-                       pos=list(obs.position), quat=rpy_to_quat(obs.rpy), rgba=[0.8, 0.2, 0.2, 1.0])
+        geom = world.add_geom(name="obstacle", type=mujoco.mjtGeom.mjGEOM_BOX, size=[s / 2 for s in obs.size],
+                              pos=list(obs.position), quat=rpy_to_quat(obs.rpy), rgba=[0.8, 0.2, 0.2, 1.0])
+        geom.solimp = OBSTACLE_SOLIMP
 
 
 def build_scene(urdf_xml: str, cfg: SceneConfig, mesh_cache: str | None = None) -> SceneModel:
