@@ -5,7 +5,7 @@ from __future__ import annotations
 import functools
 import pathlib
 import time
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from typing import Any
 
 from rosbags.rosbag1 import Reader, Writer
@@ -40,13 +40,14 @@ def write_bag(path: str | pathlib.Path, messages: Iterable[tuple[str, str, int, 
             writer.write(connections[key], stamp_ns, store.serialize_ros1(msg, msgtype))
 
 
-def read_bag(path: str | pathlib.Path) -> list[tuple[str, int, Any]]:
-    """Reads a ROS1 bag into (topic, stamp_ns, message) tuples in time order."""
+def read_bag(path: str | pathlib.Path, topics: Sequence[str] | None = None) -> list[tuple[str, int, Any]]:
+    """Reads a ROS1 bag (only ``topics`` if given) into (topic, stamp_ns, message) tuples in time order."""
     store = typestore()
     with Reader(pathlib.Path(path)) as reader:
+        connections = [c for c in reader.connections if topics is None or c.topic in topics]
         return [
             (conn.topic, stamp, store.deserialize_ros1(raw, conn.msgtype))
-            for conn, stamp, raw in reader.messages()
+            for conn, stamp, raw in reader.messages(connections=connections)
         ]
 
 

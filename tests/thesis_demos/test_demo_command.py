@@ -1,0 +1,34 @@
+"""`make demo ROBOT=ur5 DRIVER=ur_robot_driver BAG=1` as a user runs it (scripts/demo): the simulated UR5
+speaking as ur_robot_driver (125 Hz), ur5_custom's hardware.launch on top, the demonstrations read the
+driver's wrench; the run is recorded into demo.bag."""
+
+import pathlib
+import subprocess
+
+import numpy as np
+from harness.bags import read_bag
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+# The shared VM can freeze processes for 0.1-0.3 s (as in test_demos_e2e): a spoilt run is repeated.
+ATTEMPTS = 2
+
+
+def test_surface_following_through_the_emulated_ur_robot_driver_is_recorded(tmp_path):
+    """Surface following against the 125 Hz driver holds 10 +- 1.5 N over the slide (it failed at 5.9-12.3 N
+    while the simulated tool hopped on the block), and the bag holds the driver's wrench at its rate."""
+    command = [str(ROOT / "scripts/with_env"), "python", str(ROOT / "scripts/demo"), "--robot", "ur5",
+               "--driver", "ur_robot_driver", "--only", "surface_following", "--bag",
+               "--output", str(tmp_path)]
+    for _ in range(ATTEMPTS):
+        run = subprocess.run(command, capture_output=True, text=True, timeout=240, check=False)
+        if run.returncode == 0:
+            break
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    assert "[PASS] surface_following" in run.stdout
+    assert "switched controllers: started joint_group_vel_controller" in run.stdout
+    assert (tmp_path / "surface_following.png").exists() and (tmp_path / "report.md").exists()
+    wrenches = [m for _, _, m in read_bag(tmp_path / "demo.bag", topics=["/wrench"])]
+    assert len(wrenches) > 125 * 10, "less than 10 s of the driver's wrench in the bag"
+    assert {m.header.frame_id for m in wrenches} == {"tool0_controller"}
+    stamps = np.array([m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec for m in wrenches])
+    assert abs(np.median(np.diff(stamps)) - 1.0 / 125.0) < 0.001  # CB3's 125 Hz
