@@ -40,7 +40,7 @@ from mujoco_driver.description import (
     find_example_robot_data,
     read_source,
 )
-from thesis_demos.geometry import DemoGeometry, demo_motions
+from thesis_demos.geometry import SURFACE_TRAVEL, DemoGeometry, demo_motions
 
 from robot_setup.analysis import (
     LENGTH_SCALE,
@@ -258,7 +258,9 @@ def plan_robot(spec: RobotSpec, log=print) -> Plan:
     threshold = max(6.0, math.ceil(worst * 1.2 * 2.0) / 2.0)
     hard_stop = float(max(12.0, math.ceil(threshold * 1.5)))
     top = float(tip[2] - gap)
-    footprint = _round(max(0.10, 0.15 * scale), 0.01)
+    # Wide enough for surface following: the tool, centred on the block, slides SURFACE_TRAVEL on its top.
+    slide = 2.0 * (SURFACE_TRAVEL + TOOL_SIZE[0]) + 0.01
+    footprint = _round(max(0.10, 0.15 * scale, slide), 0.01)
     obstacle_size = (footprint, footprint, _round(top, 0.001))
     obstacle_position = (_round(tip[0], 0.001), _round(tip[1], 0.001), _round(top / 2.0, 0.0005))
     # Home: the start pose lifted 0.1 m (scaled), clear of the obstacle.
