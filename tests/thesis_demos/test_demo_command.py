@@ -32,3 +32,12 @@ def test_surface_following_through_the_emulated_ur_robot_driver_is_recorded(tmp_
     assert {m.header.frame_id for m in wrenches} == {"tool0_controller"}
     stamps = np.array([m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec for m in wrenches])
     assert abs(np.median(np.diff(stamps)) - 1.0 / 125.0) < 0.001  # CB3's 125 Hz
+
+
+def test_driver_options_without_a_driver_are_refused_before_anything_launches(tmp_path):
+    command = [str(ROOT / "scripts/with_env"), "python", str(ROOT / "scripts/demo"), "--robot", "ur5",
+               "--driver-options", "{series: e_series}", "--output", str(tmp_path)]
+    run = subprocess.run(command, capture_output=True, text=True, timeout=120, check=False)
+    assert run.returncode == 2
+    assert "--driver-options needs --driver" in run.stderr
+    assert not (tmp_path / "launch.log").exists()
