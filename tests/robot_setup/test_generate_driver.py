@@ -71,6 +71,7 @@ def test_ur_profile_hardware_files_use_its_topics_frames_and_controllers(ur3_pla
     assert jog["cmd_out_topic"] == f"{velocity.name}/command"
     assert jog["command_out_type"] == "velocity_array"
     assert jog["joint_state_timeout"] == pytest.approx(0.1)  # 12.5 periods at 125 Hz, 0.1 s at least
+    assert jog["pub_period"] == pytest.approx(0.004)  # a velocity stream: shorter than the 8 ms of 125 Hz
     assert cc["ft_in_topic"] == profile.wrench.topic
     assert cc["ft_sensor_frame"] == profile.wrench.frame  # tool0_controller, on the driver's tf
     assert profile.wrench.model == "payload_compensated"
@@ -136,6 +137,7 @@ def test_a_profile_path_of_another_driver_sets_its_names_sign_and_payload(ur3_pl
     # No velocity controller: jog_arm streams trajectories to the running trajectory controller, no switch.
     assert (jog["cmd_out_topic"], jog["command_out_type"]) == ("acme_traj/command", "trajectory")
     assert jog["joint_state_timeout"] == pytest.approx(0.1)  # 5 periods at 50 Hz
+    assert jog["pub_period"] == pytest.approx(0.008)  # trajectories
     assert "switch" not in files["config/jog_arm_hardware.yaml"]
     assert "No controller switch: acme_traj runs from the start." in files["README.md"]
     assert (cc["ft_in_topic"], cc["ft_sensor_frame"]) == ("acme/wrench", "acme_flange")
