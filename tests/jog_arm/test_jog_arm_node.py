@@ -6,6 +6,7 @@ import contextlib
 import itertools
 import math
 import threading
+import time
 from collections.abc import Iterator
 
 import numpy as np
@@ -234,10 +235,15 @@ def test_velocity_output_tf_frame_pause_and_launch_file(ros_node, tmp_path) -> N
             assert np.linalg.norm(twist[:3]) == pytest.approx(0.05, rel=0.05)  # 0.5 x scale/linear
 
             pause = rospy.ServiceProxy(f"/{name}/pause", Trigger)
-            assert pause().success
-            wait_until(
-                lambda: status.last().code == StatusCode.PAUSED and not any(speeds.last().data), 10, "stop"
-            )
+            answer = pause()  # answers once stopped and silent: whoever paused it may use the driver now
+            assert answer.success and answer.message.startswith("paused: at rest after stopping"), answer
+            time.sleep(0.05)  # the last commands still on the wire
+            published = len(speeds.msgs)
+            assert not any(speeds.last().data)
+            time.sleep(0.3)  # twists keep coming at 100 Hz: ignored, nothing published
+            assert len(speeds.msgs) == published
+            assert status.last().code == StatusCode.PAUSED
+            assert pause().message.startswith("already paused")
             assert rospy.ServiceProxy(f"/{name}/resume", Trigger)().success
             wait_until(lambda: any(speeds.last().data), 10, "moving again after resume")
         finally:

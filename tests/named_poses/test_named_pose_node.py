@@ -121,3 +121,51 @@ def test_a_request_before_the_first_joint_state_waits_for_it_or_says_which_topic
         finally:
             answered.set()
         assert answer.success, answer.message
+
+
+def test_a_jog_held_during_a_move_is_paused_for_it_and_resumed_after(stack):
+    """A key held down in keyboard.launch (twists streaming into jog_arm) while move_to runs: jog_arm's joint
+    commands would replace the trajectory (the arm stayed 0.3 rad from the pose: "did not reach"). named_poses
+    pauses jog_arm for the move (its answer comes once jog_arm is silent) and resumes it: the pose is reached,
+    and afterwards the same stream moves the arm again."""
+    import rospy
+    import yaml
+    from geometry_msgs.msg import PoseStamped, TwistStamped
+    from harness.streams import Repeater
+    from rospkg import RosPack
+    from sensor_msgs.msg import JointState
+
+    config = RosPack().get_path("ur5_custom") + "/config/named_poses.yaml"
+    home = yaml.safe_load(open(config))["poses"]["home"]
+    pub = rospy.Publisher("/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1, tcp_nodelay=True)
+    pose = Collector("/mujoco_driver/eef_pose", PoseStamped)
+    states = Collector("/joint_states", JointState, queue_size=10)
+    twist = TwistStamped()
+    twist.header.frame_id = "base_link"
+    twist.twist.linear.y = 0.02
+    stream = Repeater(pub)
+
+    def y() -> float:
+        return pose.last().pose.position.y
+
+    try:
+        wait_until(lambda: pub.get_num_connections() > 0, 10, "jog_arm to subscribe")
+        pose.wait_for(1, 10)
+        y0 = y()
+        stream.start(twist, rate=50.0)
+        wait_until(lambda: y() > y0 + 0.002, 10, "the jog to move the arm")
+        answer = _proxy()(name="home", speed_scale=1.0)
+        assert answer.success, answer.message
+        assert "/jog_arm_server paused for the move, then resumed" in answer.message
+        at = dict(zip(states.last().name, states.last().position, strict=True))
+        assert max(abs(at[j] - q) for j, q in home.items()) < 0.01
+        y1 = y()
+        wait_until(lambda: y() > y1 + 0.002, 10, "the jog to move the arm again after the move")
+    finally:
+        stream.stop()
+        pose.close()
+        states.close()
+        pub.unregister()
+    rospy.sleep(0.3)  # jog_arm stale and silent before the trajectory back
+    back = _proxy()(name="start", speed_scale=1.0)
+    assert back.success, back.message

@@ -419,6 +419,11 @@ class JogCalcs:
         """Whether :meth:`pause` is in effect."""
         return self._paused
 
+    @property
+    def silent(self) -> bool:
+        """At rest with the halt command repeated: nothing is published until the next command."""
+        return not self._running
+
     # --- the cycle ------------------------------------------------------------------------------------
 
     def step(self, now: float) -> JogOutput:

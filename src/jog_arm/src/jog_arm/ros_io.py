@@ -25,6 +25,8 @@ __all__ = ["JogArmRos", "load"]
 
 _TF_ERRORS = (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException)
 WARN_PERIOD = 2.0  # [s] throttle of repeated warnings of one kind
+# [s] ~pause answers at the latest after this (from full speed at the acceleration limits: about 1 s)
+PAUSE_WAIT = 2.0
 
 
 class JogArmRos:
@@ -147,8 +149,24 @@ class JogArmRos:
 
     # --- services ---
     def _on_pause(self, _req: Any) -> TriggerResponse:
+        """Pauses and answers once the arm is at rest and the halt commands are out, so that the caller
+        (named_poses before a trajectory) can use the driver at once: nothing of jog_arm's follows."""
         with self._lock:
-            return TriggerResponse(success=True, message=self._stage.pause())
+            if self._stage.pause():
+                return TriggerResponse(success=True, message="already paused: commands ignored until ~resume")
+        start = time.monotonic()
+        while not rospy.is_shutdown():
+            with self._lock:
+                if self._stage.jog.silent:
+                    waited = time.monotonic() - start
+                    stopped = f" after stopping for {waited:.2f} s" if waited > 0.001 else ""
+                    return TriggerResponse(success=True, message=(
+                        f"paused: at rest{stopped}, nothing more published; commands ignored until ~resume"))
+            if time.monotonic() - start > PAUSE_WAIT:
+                break
+            time.sleep(0.005)  # the service's own thread polls the cycles; the control loop never waits
+        return TriggerResponse(success=True, message=(
+            f"paused: still stopping after {PAUSE_WAIT:g} s; commands ignored until ~resume"))
 
     def _on_resume(self, _req: Any) -> TriggerResponse:
         with self._lock:

@@ -262,9 +262,11 @@ class JogStage:
         self.jog.prefetch()
 
     # --- modes ---
-    def pause(self) -> str:
+    def pause(self) -> bool:
+        """Pauses; whether it was paused already."""
+        was_paused = self.jog.paused
         self.jog.pause()
-        return "paused: stopping, commands ignored until ~resume"
+        return was_paused
 
     def resume(self) -> str:
         was_paused = self.jog.paused

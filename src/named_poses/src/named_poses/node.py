@@ -20,6 +20,7 @@ from compliant_control_msgs.msg import ContactControlStatus
 from compliant_control_msgs.srv import MoveToNamedPose, MoveToNamedPoseResponse
 from controller_manager_msgs.srv import ListControllers, SwitchController, SwitchControllerRequest
 from sensor_msgs.msg import JointState
+from std_srvs.srv import Trigger
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from named_poses.params import FILE_KEYS, load_settings
@@ -65,6 +66,7 @@ class NamedPoseServer:
         self._states_topic = rospy.resolve_name(settings.joint_states_topic)
         self._controller = controller_of(settings.trajectory_topic)
         self._manager = rospy.resolve_name(settings.controller_manager) if settings.controller_manager else ""
+        self._jog = rospy.resolve_name(settings.jog_arm) if settings.jog_arm else ""
         rospy.Subscriber(settings.joint_states_topic, JointState, self._on_joints,
                          queue_size=1, tcp_nodelay=True)
         rospy.Subscriber(settings.contact_control_status,
@@ -147,22 +149,59 @@ class NamedPoseServer:
             msg.points.append(JointTrajectoryPoint(
                 positions=q.tolist(), velocities=v.tolist(), time_from_start=rospy.Duration.from_sec(float(t))
             ))
-        switch = None
+        switch, paused = None, False
         if move.duration > 0.0:
+            try:
+                paused = self._pause_jog()
+            except SwitchError as exc:
+                return self._refuse(str(exc))
             try:
                 switch = self._switch_on()
             except SwitchError as exc:
-                return self._refuse(str(exc))
+                return self._refuse(str(exc) + self._resume_jog(paused))
         back = _Switched(True, "")
         try:
             answer = self._move(req.name, goal, move.duration, msg)
         finally:
             if switch is not None:
                 back = self._switch(switch.undo())
+            resumed = self._resume_jog(paused)
         if switch is not None:
             note = f"; switched {list(switch.start)} on for the move (stopping {list(switch.stop)})"
             answer.message += note + (", then back" if back else f"; switching back failed: {back.reason}")
+        answer.message += resumed
         return answer
+
+    # --- jog_arm pause (README, Jogging during a move) ---
+    def _pause_jog(self) -> bool:
+        """Pauses jog_arm for the move if it runs (asked of the master, no waiting); True if this move paused
+        it. Its answer comes once it is at rest and silent, so nothing of its follows the trajectory.
+
+        Raises:
+            SwitchError: It runs but the pause failed.
+        """
+        if not self._jog:
+            return False
+        try:
+            rosgraph.Master(rospy.get_name()).lookupService(self._jog + "/pause")
+        except (rosgraph.MasterException, OSError):
+            return False
+        try:
+            answer = rospy.ServiceProxy(self._jog + "/pause", Trigger)()
+        except (rospy.ServiceException, rospy.ROSException) as exc:
+            raise SwitchError(f"could not pause {self._jog} for the move: {exc}") from exc
+        return not answer.message.startswith("already paused")
+
+    def _resume_jog(self, paused: bool) -> str:
+        """Resumes jog_arm if this move paused it; a note for the answer."""
+        if not paused:
+            return ""
+        try:
+            rospy.ServiceProxy(self._jog + "/resume", Trigger)()
+        except (rospy.ServiceException, rospy.ROSException) as exc:
+            rospy.logerr("named_pose_server: could not resume %s: %s", self._jog, exc)
+            return f"; {self._jog} paused for the move, resuming it failed: {exc} (call {self._jog}/resume)"
+        return f"; {self._jog} paused for the move, then resumed"
 
     def _move(
         self, name: str, goal: np.ndarray, duration: float, msg: JointTrajectory

@@ -61,6 +61,12 @@ class NamedPoseSettings:
         "of `trajectory_topic` (`<controller>/command`) is not running, a move switches it on, stopping the "
         "running controllers that claim its joints, and switches back afterwards; empty: never switch",
     )
+    jog_arm: str = param(
+        "jog_arm_server",
+        doc="jog_arm's namespace: if it serves `pause`, a move pauses it first (its commands would replace "
+        "the trajectory; the answer comes once it is silent) and resumes it afterwards, unless it was "
+        "paused already; empty: never pause",
+    )
     contact_control_status: str = param(
         "/contact_control_node/status", nonempty=True,
         doc="compliant_control_msgs/ContactControlStatus input: no move while a contact move runs",
