@@ -260,8 +260,9 @@ def test_a_request_re_sent_at_100_hz_during_a_push_does_not_change_the_motion(ro
                 return _tip(pose)[2] - z0, sent[0]
 
             # A VM stall during one push (the spamming thread adds load) lets the arm run on for its length
-            # (35.0 vs 40.1 mm once in CI): a pair of pushes is repeated, at most 3 times, all printed. A
-            # restart from rest on every request would fail every pair (0.7 vs 21 mm before the fix).
+            # (35.0 vs 40.1 mm once in CI; 0.2 mm for the quiet push once with two suites on the machine): a
+            # pair of pushes is repeated, at most 3 times, all printed. A restart from rest on every request
+            # would fail every pair (0.7 vs 21 mm before the fix).
             for _ in range(3):
                 quiet, _ = pushed(5.0, spam=False)
                 pushed(-5.0, spam=False)  # back down
@@ -269,10 +270,10 @@ def test_a_request_re_sent_at_100_hz_during_a_push_does_not_change_the_motion(ro
                 pushed(-5.0, spam=False)
                 print(f"\nfollower under a 5 N push: {quiet * 1e3:.1f} mm; with the request re-sent {sent} "
                       f"times meanwhile: {spammed * 1e3:.1f} mm")
-                assert quiet > 0.01, h.output()[-3000:]
-                assert sent >= 20
-                if spammed == pytest.approx(quiet, rel=0.10):
+                if quiet > 0.01 and sent >= 20 and spammed == pytest.approx(quiet, rel=0.10):
                     break
+            assert quiet > 0.01, h.output()[-3000:]
+            assert sent >= 20
             assert spammed == pytest.approx(quiet, rel=0.10)
         finally:
             configure.close()
