@@ -24,6 +24,7 @@ def test_surface_following_through_the_emulated_ur_robot_driver_is_recorded(tmp_
         if run.returncode == 0:
             break
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    assert "[demo] running the demonstrations: surface_following\n" in run.stdout
     assert "[PASS] surface_following" in run.stdout
     assert "switched controllers: started joint_group_vel_controller" in run.stdout
     assert (tmp_path / "surface_following.png").exists() and (tmp_path / "report.md").exists()
