@@ -13,12 +13,16 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 ATTEMPTS = 2
 
 
+def _demo(*args: str) -> list[str]:
+    """`make demo`'s command line with these arguments."""
+    return [str(ROOT / "scripts/with_env"), "python", str(ROOT / "scripts/demo"), *args]
+
+
 def test_surface_following_through_the_emulated_ur_robot_driver_is_recorded(tmp_path):
     """Surface following against the 125 Hz driver holds 10 +- 1.5 N over the slide (it failed at 5.9-12.3 N
     while the simulated tool hopped on the block), and the bag holds the driver's wrench at its rate."""
-    command = [str(ROOT / "scripts/with_env"), "python", str(ROOT / "scripts/demo"), "--robot", "ur5",
-               "--driver", "ur_robot_driver", "--only", "surface_following", "--bag",
-               "--output", str(tmp_path)]
+    command = _demo("--robot", "ur5", "--driver", "ur_robot_driver", "--only", "surface_following", "--bag",
+                    "--output", str(tmp_path))
     for _ in range(ATTEMPTS):
         run = subprocess.run(command, capture_output=True, text=True, timeout=240, check=False)
         if run.returncode == 0:
@@ -36,8 +40,7 @@ def test_surface_following_through_the_emulated_ur_robot_driver_is_recorded(tmp_
 
 
 def test_driver_options_without_a_driver_are_refused_before_anything_launches(tmp_path):
-    command = [str(ROOT / "scripts/with_env"), "python", str(ROOT / "scripts/demo"), "--robot", "ur5",
-               "--driver-options", "{series: e_series}", "--output", str(tmp_path)]
+    command = _demo("--robot", "ur5", "--driver-options", "{series: e_series}", "--output", str(tmp_path))
     run = subprocess.run(command, capture_output=True, text=True, timeout=120, check=False)
     assert run.returncode == 2
     assert "--driver-options needs --driver" in run.stderr

@@ -180,11 +180,7 @@ class NamedPoseServer:
         Raises:
             SwitchError: It runs but the pause failed.
         """
-        if not self._jog:
-            return False
-        try:
-            rosgraph.Master(rospy.get_name()).lookupService(self._jog + "/pause")
-        except (rosgraph.MasterException, OSError):
+        if not self._jog or not _served(self._jog + "/pause"):
             return False
         try:
             answer = rospy.ServiceProxy(self._jog + "/pause", Trigger)()
@@ -231,9 +227,7 @@ class NamedPoseServer:
         """
         if not self._controller or not self._manager:
             return None
-        try:  # asked of the master, no waiting: a move without a controller manager pays nothing
-            rosgraph.Master(rospy.get_name()).lookupService(self._manager + "/list_controllers")
-        except (rosgraph.MasterException, OSError):
+        if not _served(self._manager + "/list_controllers"):
             return None  # no controller manager (a driver without ros_control): nothing to switch
         try:
             listing = rospy.ServiceProxy(self._manager + "/list_controllers", ListControllers)()
@@ -263,6 +257,15 @@ class NamedPoseServer:
                       list(switch.start), list(switch.stop), "ok" if ok else "refused")
         return _Switched(ok, "" if ok else f"switch_controller start {list(switch.start)} stop "
                          f"{list(switch.stop)} refused")
+
+
+def _served(service: str) -> bool:
+    """Whether the master knows `service`: asked, not waited for, so a move without that node pays nothing."""
+    try:
+        rosgraph.Master(rospy.get_name()).lookupService(service)
+    except (rosgraph.MasterException, OSError):
+        return False
+    return True
 
 
 class _Switched(NamedTuple):
