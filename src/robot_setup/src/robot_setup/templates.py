@@ -275,7 +275,7 @@ command_in_type: speed_units
 command_out_type: trajectory
 simu: false
 
-pub_period: 0.008
+{_pub_period(d)}
 incoming_cmd_timeout: 0.1
 joint_state_timeout: 0.1
 low_pass_filter_coeff: 2.5
