@@ -148,7 +148,7 @@ def test_compliant_move_stops_and_holds_when_it_meets_an_obstacle():
     assert final.ended_axis == 2 and "axis z" in final.message
     assert loop.ctrl.move_outcome(loop.ctrl.move_id) is True
     assert np.all(v[ended:] == 0.0)  # holds still afterwards, although the wall still pushes
-    assert -0.0505 < loop.pose[2, 3] < -0.05
+    assert -0.0506 < loop.pose[2, 3] < -0.05  # a cycle of 0.1 mm more: the limit must hold two wrenches
 
 
 @pytest.mark.parametrize(("arm_time", "survives"), [(0.5, True), (0.0, False)])

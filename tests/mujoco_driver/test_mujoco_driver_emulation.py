@@ -3,11 +3,15 @@ reflex, and both robots' simulations speaking as ur_robot_driver and franka_ros.
 
 from __future__ import annotations
 
+import os
+import tempfile
+
 import numpy as np
 import pytest
+import yaml
 from mujoco_driver.controllers import BEST_EFFORT, STRICT, ControllerManager, ControllerSpec
 from mujoco_driver.emulation import DriverEmulation
-from mujoco_driver.profiles import ProfileError, WrenchSpec, known_profiles, load_profile
+from mujoco_driver.profiles import ProfileError, WrenchSpec, known_profiles, load_profile, option_params
 from mujoco_driver.wrench_models import RateDivider, Reflex, WrenchModel, change_frame, gravity_wrench
 
 PROFILE_FOR = {"ur5_custom": "ur_robot_driver", "panda_custom": "franka_ros"}
@@ -218,3 +222,93 @@ def test_profile_parameters_are_validated():
     assert settings.profile == "franka_ros" and settings.profile_options == {"publish_rate": 100.0}
     with pytest.raises(ParamError, match="~profile_options: expected a mapping"):
         DriverSettings.from_params({"scene_config": "s.yaml", "profile_options": "series: e_series"})
+
+
+# ------------------------------------------------------ real sensor errors
+def _rest(spec: WrenchSpec, n: int, period: float) -> np.ndarray:
+    model = WrenchModel(spec, 2, period)
+    zero = np.zeros(6)
+    return np.array([model(zero, zero, np.zeros(2)) for _ in range(n)])
+
+
+def test_white_noise_is_per_axis_and_the_drift_is_slow_with_its_time_constant():
+    spec = WrenchSpec("w", "f", "l", model="payload_compensated", noise_force=[0.4, 0.6, 0.2],
+                      noise_torque=0.01, seed=3)
+    samples = _rest(spec, 20000, 0.002)
+    np.testing.assert_allclose(samples[:, :3].std(axis=0), [0.4, 0.6, 0.2], rtol=0.05)
+    # AR(1) drift, 0.3 N with tau 0.5 s at 500 Hz: adjacent samples almost equal, 0.5 s apart correlated 1/e.
+    spec = WrenchSpec("w", "f", "l", model="payload_compensated", drift_force=0.3, drift_time_constant=0.5,
+                      seed=4)
+    drift = _rest(spec, 200000, 0.002)[:, 0]
+    assert drift.std() == pytest.approx(0.3, rel=0.1)
+    assert np.diff(drift).std() < 0.1 * drift.std()  # a step is 0.09 of the std: slow, not white
+    lag = 250  # 0.5 s
+    rho = np.corrcoef(drift[:-lag], drift[lag:])[0, 1]
+    assert rho == pytest.approx(np.exp(-1.0), abs=0.1)
+
+
+def test_a_heavy_press_shifts_the_zero_once_released_and_a_light_one_does_not():
+    spec = WrenchSpec("w", "f", "l", model="payload_compensated", contact_shift_threshold=30.0,
+                      contact_shift_fraction=0.08, seed=5)
+    model = WrenchModel(spec, 1, 0.002)
+    q, zero = np.zeros(1), np.zeros(6)
+    press = np.array([0.0, 0.0, -116.0, 0.0, 0.0, 0.0])
+    for value in (press * 0.2, zero):  # 23 N: under the threshold
+        model(value, zero, q)
+    np.testing.assert_allclose(model(zero, zero, q), 0.0)
+    for _ in range(10):
+        model(press, zero, q)
+    during = model(press, zero, q)
+    np.testing.assert_allclose(during, press)  # the shift comes with the release, not during the press
+    after = model(zero, zero, q)
+    assert np.linalg.norm(after[:3]) == pytest.approx(0.08 * 116.0, rel=1e-6)
+    np.testing.assert_allclose(model(zero, zero, q), after)  # it stays
+    model.zero(after)
+    np.testing.assert_allclose(model(zero, zero, q), 0.0, atol=1e-12)  # zeroing removes it
+
+
+def test_a_current_estimate_lags_a_step_by_its_time_constant_and_is_net_of_the_payload():
+    spec = WrenchSpec("w", "f", "l", model="current_estimate", lag=0.05)
+    model = WrenchModel(spec, 1, 0.008)  # a CB3's 125 Hz
+    weight = np.array([0.0, 0.0, -9.81, 0.0, 0.0, 0.0])
+    q = np.zeros(1)
+    assert model(weight, weight, q)[2] == pytest.approx(0.0)
+    step = weight + np.array([10.0, 0, 0, 0, 0, 0])
+    out = [model(step, weight, q)[0] for _ in range(60)]
+    # After one time constant (0.05 s = 6.25 samples) 1 - 1/e of the step; after 0.48 s all of it.
+    assert out[5] < 10.0 * (1 - np.exp(-1.0)) < out[7]
+    assert out[-1] == pytest.approx(10.0, rel=1e-3)
+
+
+def test_the_profiles_sensor_error_keys_are_checked():
+    path = os.path.join(os.path.dirname(__file__), "..", "..", "src", "mujoco_driver", "config", "profiles")
+    base = yaml.safe_load(open(os.path.join(path, "ur_robot_driver.yaml")))
+    for key, value, words in (("noise_force", [0.1, 0.2], "three"), ("drift_force", -1.0, ">= 0"),
+                              ("model", "magic", "current_estimate"), ("lag", "x", "finite number")):
+        bad = dict(base, wrench=dict(base["wrench"], **{key: value}))
+        with tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False) as f:
+            yaml.safe_dump(bad, f)
+        with pytest.raises(ProfileError, match=words):
+            load_profile(f.name)
+        os.unlink(f.name)
+
+
+def test_options_the_real_driver_reads_from_parameters_are_named_by_the_profile():
+    assert option_params("franka_ros") == {"publish_rate": "franka_state_controller/publish_rate"}
+    assert option_params("ur_robot_driver") == {}
+    base = yaml.safe_load(open(os.path.join(os.path.dirname(__file__), "..", "..", "src", "mujoco_driver",
+                                            "config", "profiles", "franka_ros.yaml")))
+    bad = dict(base, option_params={"rate": "franka_state_controller/publish_rate"})  # not an option
+    with tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False) as f:
+        yaml.safe_dump(bad, f)
+    with pytest.raises(ProfileError, match="must be an option"):
+        option_params(f.name)
+    os.unlink(f.name)
+
+
+def test_the_series_variants_carry_their_sensor():
+    e = load_profile("ur_robot_driver", {"series": "e_series"}).wrench
+    assert e.model == "payload_compensated" and e.topic == "wrench" and max(e.noise_force) > 0.1
+    assert e.contact_shift_threshold > 0.0
+    cb3 = load_profile("ur_robot_driver", {"series": "cb3_estimate"}).wrench
+    assert cb3.model == "current_estimate" and cb3.noise_force == 3.6 and cb3.frame == "tool0_controller"

@@ -45,10 +45,11 @@ from contact_control.axes import (
 )
 from contact_control.exceeded import ExceededReaction
 from contact_control.laws import AxisLaw, ForceWindow, check_end, law_velocity, shape_velocity
+from contact_control.noise_floor import NoiseFloor
 from contact_control.params import ContactControlSettings
 from contact_control.preprocess import PreprocessError, WrenchPreprocessor, as_rows, is_finite6
 from contact_control.rate import SamplePeriod
-from contact_control.request import FAILURE, RequestError
+from contact_control.request import FAILURE, SET_CONTROL_FORCE_FAILED, RequestError
 from contact_control.travel import TravelMeter
 from contact_control.zeroing import SteadyZero
 
@@ -215,9 +216,13 @@ class ContactControl:
         self._last_t: float | None = None
         self._tare_pending = s.tare_on_startup
         self._zeroing = (
-            SteadyZero(s.tare_window, s.tare_max_force_spread, s.tare_max_torque_spread)
+            SteadyZero(s.tare_window, s.tare_max_force_spread, s.tare_max_torque_spread,
+                       int(s.tare_min_samples))
             if s.tare_on_startup and s.tare_window > 0.0 else None
         )
+        self._floor_noise: NoiseFloor | None = None
+        self._limit_samples = int(s.force_limit_samples)
+        self._over = [0] * 6  # per axis: wrenches in a row over its force limit
         self._last_raw: Sequence[float] | None = None
         self._last_R: Any = None
         self.last_result = self._result(0.0, SAFETY_STALE, "no wrench yet")
@@ -261,6 +266,42 @@ class ContactControl:
         return self._tare_pending
 
     @property
+    def noise_floor(self) -> NoiseFloor | None:
+        """The sensor's noise at rest, measured while zeroing at start-up (None before, or if not zeroed)."""
+        return self._floor_noise
+
+    def resolvable(self) -> tuple[float, float]:
+        """The smallest force [N] and torque [Nm] limits a request may set (0, 0: unknown or unchecked)."""
+        sigmas = self.settings.noise_limit_sigmas
+        if self._floor_noise is None or sigmas <= 0.0:
+            return 0.0, 0.0
+        return self._floor_noise.resolvable(sigmas)
+
+    def check_resolvable(self, laws: Sequence[AxisLaw]) -> None:
+        """Refuses limits the sensor cannot tell from its noise.
+
+        Raises:
+            RequestError: SET_CONTROL_FORCE_FAILED naming the axis, the limit and the noise floor.
+        """
+        floor = self._floor_noise
+        if floor is None:
+            return
+        force, torque = self.resolvable()
+        for i, law in enumerate(laws):
+            least = torque if i >= 3 else force
+            if law.law and 0.0 < law.force_limit < least:
+                unit, what = ("Nm", "torque") if i >= 3 else ("N", "force")
+                std = floor.torque if i >= 3 else floor.force
+                raise RequestError(
+                    SET_CONTROL_FORCE_FAILED,
+                    f"axis {AXES[i]}: {what} limit {law.force_limit:g} {unit} is below what the sensor "
+                    f"resolves, {least:.3g} {unit} ({self.settings.noise_limit_sigmas:g} x its filtered "
+                    f"noise {std:.3g} {unit}, measured at rest while zeroing; noise_limit_sigmas): set a "
+                    f"limit of at least {least:.3g} {unit}",
+                    AXES[i],
+                )
+
+    @property
     def safety_latched(self) -> bool:
         return self._latched
 
@@ -292,6 +333,8 @@ class ContactControl:
             raise ValueError("set_laws needs six AxisLaw (x, y, z, rx, ry, rz)")
         if self._latched:
             raise RequestError(FAILURE, f"safety latched ({self._latch_message}); call reset first")
+        self.check_resolvable(laws)
+        self._over = [0] * 6
         if self._move_active and any(law.law for law in laws):
             if laws == self._laws:  # a re-sent request (GUI Apply held, a script in a loop): nothing changes
                 return self._move_id
@@ -467,11 +510,12 @@ class ContactControl:
                 bias = zeroing.add(self.preprocessor.bias_estimate(wrench, R_world_sensor), t)
                 if bias is None:
                     return self._hold(t, SAFETY_ZEROING, zeroing.note)
-                self.preprocessor.set_bias(bias)
+                self.preprocessor.set_bias(bias, at_rest=True)
                 self.notes.append(
-                    f"sensor zeroed over {zeroing.window:g} s: bias "
+                    f"sensor zeroed over {zeroing.duration:.3g} s: bias "
                     f"[{', '.join(f'{b:.3g}' for b in bias)}] (N, Nm, sensor frame, tool weight out)"
                 )
+                self._measured_floor(zeroing)
             self._tare_pending = False
         code, w = self.preprocessor.process(wrench, T_control_sensor, R_world_sensor)
         if code != SAFETY_OK:
@@ -497,8 +541,15 @@ class ContactControl:
                     travel[i] -= offset[i]
         laws = self._laws
         armed = self._armed
+        over = self._over
         for i in self._active:
             end = check_end(laws[i], w[i] if armed[i] else 0.0, travel[i])
+            if end == END_FT_VIOLATION:
+                over[i] += 1
+                if over[i] < self._limit_samples:  # one spike over the limit is not a contact
+                    end = check_end(laws[i], 0.0, travel[i])
+            elif over[i]:
+                over[i] = 0
             if end:
                 return self._end_and_hold(t, i, end)
         for i in self._diff_axes:
@@ -518,6 +569,29 @@ class ContactControl:
             if t - self._from_rest >= self._arm_time:
                 self._armed = [True] * 6
         return self._result(t, SAFETY_OK, "")
+
+    def _measured_floor(self, zeroing: SteadyZero) -> None:
+        """The noise floor of the zeroing window; the deadbands grow to `noise_deadband_sigmas` of it."""
+        s = self.settings
+        n = zeroing.count
+        period = self._rate.period
+        rate = 1.0 / period if period else (n - 1) / zeroing.duration if zeroing.duration > 0.0 else 0.0
+        if n < 2 or rate <= 0.0:
+            return
+        cutoff = self.preprocessor.cutoff if s.lp_filter_enabled else None
+        floor = NoiseFloor.measure(zeroing.std(), rate, n, cutoff, zeroing.lag1())
+        self._floor_noise = floor
+        note = floor.describe()
+        k = s.noise_deadband_sigmas
+        if k > 0.0:
+            force_db = max(s.force_deadband, k * floor.force)
+            torque_db = max(s.torque_deadband, k * floor.torque)
+            self.preprocessor.set_deadband(force_db, torque_db)
+            note += f"; deadbands {force_db:.3g} N, {torque_db:.3g} Nm ({k:g} filtered stds or as set)"
+        force, torque = self.resolvable()
+        if force > 0.0:
+            note += f"; force limits below {force:.3g} N, torque limits below {torque:.3g} Nm are refused"
+        self.notes.append(note)
 
     def contact_force(
         self, wrench: Sequence[float], T_control_sensor: Any = None, R_world_sensor: Any = None

@@ -124,6 +124,22 @@ class ContactControlSettings:
         (0.0,) * 6, type="floats", length=6, unit="N, Nm",
         doc="known sensor offset (sensor frame) subtracted until the first tare",
     )
+    tare_min_samples: float = _nonneg(
+        25.0, "", "start-up zeroing also waits for this many samples (0.83 s of a 30 Hz sensor): the noise "
+        "floor (std per axis) is measured over the same window"
+    )
+    noise_deadband_sigmas: float = _nonneg(
+        4.0, "filtered noise stds", "`force_deadband` / `torque_deadband` are at least this many filtered "
+        "noise stds of the noise floor measured at zeroing (0: only the configured deadbands)"
+    )
+    noise_limit_sigmas: float = _nonneg(
+        5.0, "filtered noise stds", "a request's force/torque limit below this many filtered noise stds is "
+        "refused (the sensor cannot tell it from its noise); 0: not checked"
+    )
+    force_limit_samples: float = param(
+        2.0, ge=1.0, doc="a force/torque limit ends a move once exceeded on this many wrenches in a row (one "
+        "spike does not; 1: the first, as the fork)"
+    )
     tool_mass: float = _nonneg(
         0.0, "kg", "payload below the sensor, gravity-compensated (the robot package's description.args "
         "`--tool-mass`)"

@@ -61,13 +61,15 @@ class WrenchPreprocessor:
         """Current offset subtracted from the (sign-flipped) sensor wrench, net of tool gravity at tare."""
         return tuple(self._bias)
 
-    def set_bias(self, bias: Sequence[float]) -> None:
-        """Sets the offset directly (sensor frame, after sign flips)."""
+    def set_bias(self, bias: Sequence[float], at_rest: bool = False) -> None:
+        """Sets the offset directly (sensor frame, after sign flips). `at_rest`: it is the mean of the current
+        readings, so the filter restarts from zero (not from the next sample, which holds a whole sample's
+        noise)."""
         if len(bias) != 6 or not is_finite6(bias):
             raise PreprocessError(f"bias must be 6 finite numbers, got {bias!r}")
         self._bias = [float(b) for b in bias]
         if self._filter:
-            self._filter.reset()
+            self._filter.reset([0.0] * 6 if at_rest else None)
 
     def set_limits(self, max_force: float, max_torque: float) -> None:
         """Global limits on |force| [N] and |torque| [Nm] of the compensated sensor wrench."""
@@ -93,6 +95,11 @@ class WrenchPreprocessor:
         except ValueError as err:
             raise PreprocessError(str(err)) from err
         self._cutoff, self.design_period = cutoff_freq, delta_t
+
+    @property
+    def cutoff(self) -> float:
+        """The low-pass filter's cutoff at its current design [Hz]."""
+        return min(self._cutoff, 0.45 / self.design_period)
 
     def redesign_filter(self, period: float) -> float | None:
         """Designs the filter anew for samples `period` [s] apart, keeping its cutoff in Hz (below 0.45 of the

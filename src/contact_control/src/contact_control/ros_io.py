@@ -272,6 +272,9 @@ class ContactControlRos:
         for i, axis in enumerate(msg.axes):
             axis.law, axis.end_condition = r.laws[i], r.end_conditions[i]
             axis.force, axis.velocity, axis.travel = w[i], v[i], r.travel[i]
+        floor = self._stage.ctrl.noise_floor
+        if floor is not None and not msg.noise_std:
+            msg.noise_std, msg.noise_filtered = list(floor.std), list(floor.filtered)
         fill_status_words(msg, r)
         self._status_pub.publish(msg)
 

@@ -8,6 +8,7 @@ A contact held perfectly still through the whole window cannot be told from a se
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 __all__ = ["SteadyZero"]
@@ -17,20 +18,33 @@ class SteadyZero:
     """The mean of the bias estimates (sensor frame, tool weight out) over `window` [s] in which no force
     component moved more than `max_force_spread` [N] and no torque more than `max_torque_spread` [Nm]."""
 
-    def __init__(self, window: float, max_force_spread: float, max_torque_spread: float) -> None:
+    def __init__(self, window: float, max_force_spread: float, max_torque_spread: float,
+                 min_samples: int = 1) -> None:
         self.window = window
+        self.min_samples = max(1, min_samples)  # the noise floor needs a few samples at a slow sensor's rate
         self._limits = (max_force_spread,) * 3 + (max_torque_spread,) * 3
         self._t0: float | None = None
         self._sum = [0.0] * 6
+        self._squares = [0.0] * 6
+        self._lagged = [0.0] * 6  # sum of x_k x_(k-1): the lag-1 autocorrelation (how slow the noise is)
+        self._previous = [0.0] * 6
+        self._origin = [0.0] * 6
+        self._shifted = [0.0] * 6
         self._low = [0.0] * 6
         self._high = [0.0] * 6
         self._count = 0
+        self.duration = 0.0  # [s] of the completed window
         #: Why it is still waiting, in words (for ~status).
         self.note = "zeroing the sensor: waiting for the first wrench"
 
     def _restart(self, estimate: Sequence[float], t: float) -> None:
         self._t0 = t
         self._sum = list(estimate)
+        self._origin = list(estimate)  # the statistics use values relative to the first: no cancellation
+        self._shifted = [0.0] * 6
+        self._squares = [0.0] * 6
+        self._lagged = [0.0] * 6
+        self._previous = [0.0] * 6
         self._low = list(estimate)
         self._high = list(estimate)
         self._count = 1
@@ -59,11 +73,43 @@ class SteadyZero:
                 )
                 self._restart(estimate, t)
                 return None
+            previous, origin = self._previous, self._origin
             for i, value in enumerate(estimate):
                 self._sum[i] += value
+                x = value - origin[i]
+                self._shifted[i] += x
+                self._squares[i] += x * x
+                self._lagged[i] += x * previous[i]
+                previous[i] = x
             self._count += 1
-        if t - t0 < self.window:
+        if t - t0 < self.window or self._count < self.min_samples:
             if self._count == 1:
                 self.note = f"zeroing the sensor over {self.window:g} s: keep the tool free and still"
             return None
+        self.duration = t - t0
         return [total / self._count for total in self._sum]
+
+    @property
+    def count(self) -> int:
+        """Samples in the current (or completed) window."""
+        return self._count
+
+    def std(self) -> list[float]:
+        """Standard deviation per axis over the window so far (sample std; 0 with one sample)."""
+        n = self._count
+        if n < 2:
+            return [0.0] * 6
+        return [math.sqrt(max(0.0, (sq - s * s / n) / (n - 1)))
+                for s, sq in zip(self._shifted, self._squares, strict=True)]
+
+    def lag1(self) -> list[float]:
+        """Lag-1 autocorrelation per axis over the window (0: white noise; near 1: a slow drift)."""
+        n = self._count
+        if n < 3:
+            return [0.0] * 6
+        out = []
+        for s, sq, lagged in zip(self._shifted, self._squares, self._lagged, strict=True):
+            mean = s / n
+            var = sq / n - mean * mean
+            out.append(max(-1.0, min(1.0, (lagged / (n - 1) - mean * mean) / var)) if var > 1e-18 else 0.0)
+        return out

@@ -40,7 +40,7 @@ from mujoco_driver.emulation import DriverEmulation
 from mujoco_driver.latency import LatencyProbe
 from mujoco_driver.pacing import Pacer, RtfMeter, TrailingPublication
 from mujoco_driver.params import DriverSettings, ParamError, load_scene, urdf_root_link
-from mujoco_driver.profiles import DriverProfile, ProfileError, load_profile
+from mujoco_driver.profiles import DriverProfile, ProfileError, load_profile, option_params
 from mujoco_driver.scene import SceneError
 from mujoco_driver.sim import CommandError, Simulation
 
@@ -580,7 +580,13 @@ def main(argv: list[str] | None = None) -> int:
         urdf = rospy.get_param(key)
         profile = None
         if settings.profile:
-            profile = load_profile(settings.profile, settings.profile_options)
+            options = dict(settings.profile_options or {})
+            for option, name in option_params(settings.profile).items():
+                if option not in options and rospy.has_param(name):  # the driver configuration's value
+                    options[option] = rospy.get_param(name)
+                    rospy.loginfo("mujoco_driver: option %s = %r from parameter %s", option, options[option],
+                                  rospy.resolve_name(name))
+            profile = load_profile(settings.profile, options)
             # The real driver's names win over the driver's own topic parameters.
             settings = dataclasses.replace(settings, joint_states_topic=profile.joint_states_topic,
                                            wrench_topic=profile.wrench.topic, ft_frame=profile.wrench.frame)

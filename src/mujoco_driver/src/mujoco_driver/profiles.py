@@ -9,8 +9,12 @@ profiles' YAML):
 * ``options``: the defaults; users may set only these keys;
 * an option named like a top-level key sets that key (``publish_rate``);
 * ``variants: {option: {value: {key: value, ...}}}``: an option's value selects overrides
-  (``series: e_series`` -> ``publish_rate: 500``);
-* every string may use ``{option}`` placeholders (``"{arm_id}_K"``).
+  (``series: e_series`` -> ``publish_rate: 500``; a mapping such as ``wrench`` is merged key by key);
+* every string may use ``{option}`` placeholders (``"{arm_id}_K"``);
+* ``option_params: {option: parameter}``: the parameter the real driver reads that option from (a state
+  controller's ``publish_rate``); the node takes it from the parameter server when the user's
+  options do not set it, so a robot package's driver configuration reaches the emulation as it reaches the
+  real driver.
 """
 
 from __future__ import annotations
@@ -26,11 +30,11 @@ import yaml
 from mujoco_driver.controllers import ControllerError, ControllerSpec
 
 __all__ = ["DriverProfile", "FrameLink", "ProfileError", "ReflexSpec", "WrenchSpec", "known_profiles",
-           "load_profile", "profile_path"]
+           "load_profile", "option_params", "profile_path"]
 
 PROFILE_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
                            "config", "profiles")
-_MODELS = ("sensor", "payload_compensated", "external_estimate")
+_MODELS = ("sensor", "payload_compensated", "external_estimate", "current_estimate")
 
 
 class ProfileError(ValueError):
@@ -46,14 +50,21 @@ class WrenchSpec:
         frame: Its header.frame_id (a tf frame the profile's ``tf`` or the description provides).
         frame_link: URDF link with the frame's origin and axes (the wrench is transformed into it).
         model: ``sensor`` (raw wrist sensor: tool weight included), ``payload_compensated`` (the tool's
-            weight removed, as a controller that knows its payload) or ``external_estimate`` (a model-based
-            estimate: weight removed, plus a configuration-dependent offset and noise).
+            weight removed, as a controller that knows its payload), ``external_estimate`` (a model-based
+            estimate from joint torques: weight removed) or ``current_estimate`` (from motor currents: weight
+            removed, low-pass filtered by ``lag``).
         sign: +1: the wrench the environment exerts on the tool; -1: its opposite (the wrench the robot
             exerts on the environment).
-        offset_force, offset_torque: Amplitude of the estimate's offset [N, Nm] (external_estimate).
+        offset_force, offset_torque: Amplitude of the configuration-dependent offset [N, Nm].
         offset_scale: Joint-space frequency of the offset [1/rad]: how fast it changes with the configuration.
-        noise_force, noise_torque: Standard deviation of the estimate's noise [N, Nm].
-        seed: Random seed of the offset's shape and of the noise.
+        noise_force, noise_torque: Standard deviation of the white noise [N, Nm], one for all three axes or
+            one per axis.
+        drift_force, drift_torque: Stationary standard deviation of the slow drift (AR(1)) [N, Nm], idem.
+        drift_time_constant: The drift's correlation time [s] (0: no drift).
+        lag: Time constant of the first-order filter on the value [s] (0: none).
+        contact_shift_threshold: A contact force above this [N] shifts the zero once released (0: never).
+        contact_shift_fraction: The shift's size as a fraction of the contact's peak force.
+        seed: Random seed of the offset's shape, the noise, the drift and the shifts.
         zero_service: std_srvs/Trigger service that zeroes the wrench ("" = none).
     """
 
@@ -65,8 +76,14 @@ class WrenchSpec:
     offset_force: float = 0.0
     offset_torque: float = 0.0
     offset_scale: float = 0.5
-    noise_force: float = 0.0
-    noise_torque: float = 0.0
+    noise_force: float | tuple[float, ...] = 0.0
+    noise_torque: float | tuple[float, ...] = 0.0
+    drift_force: float | tuple[float, ...] = 0.0
+    drift_torque: float | tuple[float, ...] = 0.0
+    drift_time_constant: float = 0.0
+    lag: float = 0.0
+    contact_shift_threshold: float = 0.0
+    contact_shift_fraction: float = 0.0
     seed: int = 0
     zero_service: str = ""
 
@@ -185,11 +202,52 @@ def _number(data: Mapping[str, Any], key: str, where: str, default: float | None
     return float(value)
 
 
+def _per_axis(data: Mapping[str, Any], key: str, where: str) -> float | tuple[float, ...]:
+    """A number >= 0 for three axes, or a list of three."""
+    value = data.get(key, 0.0)
+    if isinstance(value, list):
+        if len(value) != 3:
+            raise ProfileError(f"{where}.{key}: expected one number or three [x, y, z], got {value!r}")
+        return tuple(_number({key: v}, key, where) for v in value)
+    return _number(data, key, where, 0.0)
+
+
 def _string(data: Mapping[str, Any], key: str, where: str, default: str | None = None) -> str:
     value = data.get(key, default)
     if value is None or not isinstance(value, str) or (default is None and not value):
         raise ProfileError(f"{where}.{key}: expected a non-empty string, got {value!r}")
     return value
+
+
+def _read(path: str) -> Mapping[str, Any]:
+    try:
+        with open(path) as stream:
+            raw = yaml.safe_load(stream)
+    except (OSError, yaml.YAMLError) as exc:
+        raise ProfileError(f"driver profile {path}: cannot read: {exc}") from None
+    if not isinstance(raw, Mapping):
+        raise ProfileError(f"driver profile {path}: expected a mapping")
+    return raw
+
+
+def option_params(name_or_path: str) -> dict[str, str]:
+    """The parameters the real driver reads options from: {option: parameter name} (see the module docstring).
+
+    Raises:
+        ProfileError: No such profile, or an entry that is not an option name mapped to a parameter name.
+    """
+    path = profile_path(name_or_path)
+    raw = _read(path)
+    entries = raw.get("option_params") or {}
+    options = raw.get("options") or {}
+    where = f"{os.path.basename(path)}.option_params"
+    if not isinstance(entries, Mapping):
+        raise ProfileError(f"{where}: expected a mapping {{option: parameter}}")
+    for option, name in entries.items():
+        if option not in options or not isinstance(name, str) or not name:
+            raise ProfileError(f"{where}.{option}: must be an option ({sorted(options)}) mapped to a "
+                               "parameter name")
+    return dict(entries)
 
 
 def load_profile(name_or_path: str, options: Mapping[str, Any] | None = None) -> DriverProfile:
@@ -203,25 +261,21 @@ def load_profile(name_or_path: str, options: Mapping[str, Any] | None = None) ->
         ProfileError: Naming the file and the bad key.
     """
     path = profile_path(name_or_path)
-    try:
-        with open(path) as stream:
-            raw = yaml.safe_load(stream)
-    except (OSError, yaml.YAMLError) as exc:
-        raise ProfileError(f"driver profile {path}: cannot read: {exc}") from None
-    if not isinstance(raw, Mapping):
-        raise ProfileError(f"driver profile {path}: expected a mapping")
+    raw = _read(path)
     where = os.path.basename(path)
     resolved = dict(raw.get("options") or {})
     for key, value in (options or {}).items():
         if key not in resolved:
             raise ProfileError(f"{where}: unknown option {key!r} (options: {sorted(resolved)})")
         resolved[key] = value
-    data = {k: v for k, v in raw.items() if k not in ("options", "variants")}
+    data = {k: v for k, v in raw.items() if k not in ("options", "variants", "option_params")}
     for option, choices in (raw.get("variants") or {}).items():
         value = resolved.get(option)
         if value not in choices:
             raise ProfileError(f"{where}: option {option}={value!r} must be one of {sorted(choices)}")
-        data.update(choices[value])
+        for key, override in choices[value].items():  # a mapping (wrench) is merged key by key
+            merge = isinstance(override, Mapping) and isinstance(data.get(key), Mapping)
+            data[key] = {**data[key], **override} if merge else override
     for key, value in resolved.items():
         if key in data:
             data[key] = value
@@ -253,8 +307,14 @@ def load_profile(name_or_path: str, options: Mapping[str, Any] | None = None) ->
         offset_force=_number(w, "offset_force", f"{where}.wrench", 0.0),
         offset_torque=_number(w, "offset_torque", f"{where}.wrench", 0.0),
         offset_scale=_number(w, "offset_scale", f"{where}.wrench", 0.5),
-        noise_force=_number(w, "noise_force", f"{where}.wrench", 0.0),
-        noise_torque=_number(w, "noise_torque", f"{where}.wrench", 0.0),
+        noise_force=_per_axis(w, "noise_force", f"{where}.wrench"),
+        noise_torque=_per_axis(w, "noise_torque", f"{where}.wrench"),
+        drift_force=_per_axis(w, "drift_force", f"{where}.wrench"),
+        drift_torque=_per_axis(w, "drift_torque", f"{where}.wrench"),
+        drift_time_constant=_number(w, "drift_time_constant", f"{where}.wrench", 0.0),
+        lag=_number(w, "lag", f"{where}.wrench", 0.0),
+        contact_shift_threshold=_number(w, "contact_shift_threshold", f"{where}.wrench", 0.0),
+        contact_shift_fraction=_number(w, "contact_shift_fraction", f"{where}.wrench", 0.0),
         seed=int(_number(w, "seed", f"{where}.wrench", 0)),
         zero_service=_string(w, "zero_service", f"{where}.wrench", ""),
     )

@@ -7,11 +7,15 @@ the tool's inertial force) in the sensor frame. A driver reports something else:
 * ``payload_compensated``: minus the tool's weight, as a controller that knows its payload (with the
   payload set, its TCP wrench reads zero at rest in any orientation);
 * ``external_estimate``: a model-based estimate from joint torques (a torque-sensing arm's driver): net of
-  the configured load's weight, plus an offset that varies smoothly with the joint configuration (model
-  and friction errors) and white noise.
+  the configured load's weight;
+* ``current_estimate``: an estimate from joint motor currents (an arm without a wrist sensor, a UR CB3):
+  net of the payload, and low-pass filtered by the controller (``lag``).
 
 Then the profile's sign: -1 reports the wrench the robot exerts on the environment (the profile YAML says
-which driver does that).
+which driver does that). Then the errors of a real sensor, each off unless the profile sets it
+(mujoco_driver's README, *Sensor errors*): white noise per axis, a slow drift (AR(1): stationary std
+``drift_*``, time constant ``drift_time_constant``), an offset that varies smoothly with the joint
+configuration (``offset_*``), and a shift of the zero after a heavy contact (``contact_shift_*``).
 """
 
 from __future__ import annotations
@@ -56,9 +60,12 @@ class WrenchModel:
     Args:
         spec: The profile's wrench section.
         n_joints: Number of arm joints (the offset is a function of them).
+        period: Time between two calls [s] (the drift and the lag advance by it).
     """
 
-    def __init__(self, spec: WrenchSpec, n_joints: int) -> None:
+    def __init__(self, spec: WrenchSpec, n_joints: int, period: float = 0.002) -> None:
+        if not period > 0.0:
+            raise ValueError(f"period must be > 0, got {period}")
         self.spec = spec
         self._rng = np.random.default_rng(spec.seed)
         # Offset: each component a sine of a random direction in joint space (|direction| = offset_scale
@@ -68,14 +75,49 @@ class WrenchModel:
         self._directions = directions
         self._phases = self._rng.uniform(0.0, 2.0 * np.pi, 6)
         self._amplitude = np.array([spec.offset_force] * 3 + [spec.offset_torque] * 3)
-        self._noise = np.array([spec.noise_force] * 3 + [spec.noise_torque] * 3)
+        self._has_offset = bool(np.any(self._amplitude))
+        self._noise = np.concatenate([_triple(spec.noise_force), _triple(spec.noise_torque)])
+        # AR(1) drift x' = a x + sqrt(1 - a^2) sigma w: stationary std sigma, correlation time tau.
+        self._drift_std = np.concatenate([_triple(spec.drift_force), _triple(spec.drift_torque)])
+        self._has_drift = bool(np.any(self._drift_std)) and spec.drift_time_constant > 0.0
+        a = np.exp(-period / spec.drift_time_constant) if self._has_drift else 0.0
+        self._drift_a, self._drift_b = a, np.sqrt(1.0 - a * a) * self._drift_std
+        self._drift = self._rng.normal(size=6) * self._drift_std if self._has_drift else np.zeros(6)
+        self._lag = 1.0 - np.exp(-period / spec.lag) if spec.lag > 0.0 else 1.0
+        self._lagged: np.ndarray | None = None
+        self._shift = np.zeros(6)  # the zero's shift after heavy contacts
+        self._peak = 0.0  # the contact's peak force while above contact_shift_threshold [N]
         self._bias = np.zeros(6)
+        self._value = np.zeros(6)
+
+    @property
+    def shift(self) -> np.ndarray:
+        """The zero's total shift from heavy contacts so far [N, Nm] (a copy)."""
+        return self._shift.copy()
+
+    @property
+    def drift(self) -> np.ndarray:
+        """The drift term's current value [N, Nm] (a copy)."""
+        return self._drift.copy()
 
     def offset(self, q: np.ndarray) -> np.ndarray:
-        """The estimate's configuration-dependent offset at joint positions ``q`` [N, Nm]."""
-        if self.spec.model != "external_estimate":
+        """The configuration-dependent offset at joint positions ``q`` [N, Nm]."""
+        if not self._has_offset:
             return np.zeros(6)
         return self._amplitude * np.sin(self._directions @ q + self._phases)
+
+    def _contact(self, force: np.ndarray) -> None:
+        """A heavy contact (over the threshold) leaves the zero shifted once it is released, by a fraction of
+        its peak in a random direction (a recorded wrist sensor: ~9 N after a 116 N press)."""
+        threshold = self.spec.contact_shift_threshold
+        magnitude = float(np.linalg.norm(force))
+        if magnitude > threshold:
+            self._peak = max(self._peak, magnitude)
+        elif self._peak > 0.0 and magnitude < 0.5 * threshold:
+            direction = self._rng.normal(size=3)
+            direction /= np.linalg.norm(direction)
+            self._shift[:3] += self.spec.contact_shift_fraction * self._peak * direction
+            self._peak = 0.0
 
     def __call__(self, sensor: np.ndarray, weight: np.ndarray, q: np.ndarray) -> np.ndarray:
         """The published wrench.
@@ -88,18 +130,40 @@ class WrenchModel:
         Returns:
             The wrench the driver publishes (after :meth:`zero`'s bias).
         """
-        value = np.array(sensor, dtype=float)
+        value = self._value
+        value[:] = sensor
         if self.spec.model != "sensor":
             value -= weight
+        if self.spec.contact_shift_threshold > 0.0:
+            self._contact(value[:3] if self.spec.model != "sensor" else value[:3] - weight[:3])
         value *= self.spec.sign
-        if self.spec.model == "external_estimate":  # errors of the published estimate, whatever its sign
+        if self._lag < 1.0:  # the controller's filter on a current-based estimate
+            if self._lagged is None:
+                self._lagged = value.copy()
+            self._lagged += self._lag * (value - self._lagged)
+            value[:] = self._lagged
+        # Errors of the published value, whatever its sign.
+        if self._has_offset:
             value += self.offset(q)
+        if self._has_drift:
+            self._drift *= self._drift_a
+            self._drift += self._drift_b * self._rng.normal(size=6)
+            value += self._drift
+        if self._noise.any():
             value += self._rng.normal(0.0, 1.0, 6) * self._noise
+        value += self._shift
         return value - self._bias
 
     def zero(self, published: np.ndarray) -> None:
         """Zero the sensor: what is published now reads zero from now on (``zero_ftsensor``)."""
         self._bias = self._bias + np.asarray(published, dtype=float)
+
+
+def _triple(value: float | Sequence[float]) -> np.ndarray:
+    """One number for three axes, or one each."""
+    if isinstance(value, int | float):
+        return np.full(3, float(value))
+    return np.asarray(value, dtype=float).reshape(3)
 
 
 class RateDivider:

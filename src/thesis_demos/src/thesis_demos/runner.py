@@ -209,13 +209,16 @@ class DemoRunner:
         )
         q = tf.transform.rotation
         x, y, z, w = q.x, q.y, q.z, q.w
+        # The wrench is read as contact_control reads it: its ft_*_direction sign flips first (a driver that
+        # reports the wrench the robot exerts has all three -1 in its robot package's hardware YAML).
+        signs = [float(rospy.get_param(f"{self.names.contact_control}/ft_{a}_direction", 1)) for a in "xyz"]
         self._sensor_rotation = np.array(
             [
                 [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
             ]
-        )
+        ) @ np.diag(signs)
 
     def _settle(self, timeout: float = 10.0, window: float = 0.3, tolerance: float = 2e-4) -> None:
         """Waits until the tool has moved less than `tolerance` over `window` seconds."""

@@ -1,0 +1,131 @@
+"""Contact control that knows its sensor: the noise floor measured while zeroing, the deadbands and the
+smallest force limits derived from it, and force limits that one spike does not end (generated data)."""
+
+import numpy as np
+import pytest
+from cc_sim import DT, ClosedLoop, laws
+from contact_control.axes import END_FT_VIOLATION, END_NONE, LAW_COMPLIANT_MOVE, LAW_FOLLOWER, SAFETY_OK
+from contact_control.laws import AxisLaw
+from contact_control.noise_floor import NoiseFloor, filtered_fraction
+from contact_control.request import SET_CONTROL_FORCE_FAILED, RequestError
+
+from contact_control import ContactControl, load_settings
+
+NOISE = np.array([0.41, 0.63, 0.18, 0.01, 0.01, 0.005])  # UR e-series at rest (500 Hz), N and Nm
+
+
+def zeroed(noise=NOISE, rate=500.0, seed=1, **params):
+    """A controller zeroed on `rate` Hz samples of white noise around an offset; returns it and the noise."""
+    ctrl = ContactControl(load_settings({"lp_filter_delta_t": 1.0 / rate, **params}))
+    rng = np.random.default_rng(seed)
+    offset = np.array([3.0, 3.2, -18.0, 0.1, 0.2, 0.0])
+    t = 0.0
+    for _ in range(10000):
+        if not ctrl.zeroing:
+            return ctrl, rng, offset, t
+        ctrl.update((offset + rng.normal(size=6) * noise).tolist(), t, stamp=t)
+        t += 1.0 / rate
+    raise AssertionError(f"never zeroed: {ctrl.last_result.message}")
+
+
+def test_the_noise_floor_is_measured_while_zeroing_and_reported():
+    ctrl, _, _, t = zeroed()
+    floor = ctrl.noise_floor
+    assert floor is not None and floor.rate == pytest.approx(500.0)
+    assert floor.samples >= 100 and t == pytest.approx(0.2, abs=0.01)  # 0.2 s window at 500 Hz
+    np.testing.assert_allclose(floor.std, NOISE, rtol=0.2)
+    # After the 5 Hz filter, white noise at 500 Hz keeps sqrt(2 * 1.11 * 5 / 500) = 0.149 of its std.
+    np.testing.assert_allclose(np.array(floor.filtered) / floor.std, 0.149, rtol=0.01)
+    assert any("noise floor at rest" in note and "refused" in note for note in ctrl.notes)
+
+
+def test_a_slow_sensor_is_zeroed_over_enough_samples_to_measure_its_noise():
+    ctrl, _, _, t = zeroed(noise=NOISE * 0.5, rate=30.0)
+    # 25 samples, not the 6 of 0.2 s
+    assert ctrl.noise_floor.samples == 25 and t == pytest.approx(25 / 30.0, abs=0.04)
+    assert filtered_fraction(30.0, 5.0) == pytest.approx(np.sqrt(2 * 1.1107 * 5 / 30), rel=1e-3)
+
+
+def test_a_force_limit_below_what_the_sensor_resolves_is_refused_with_the_reason_and_changes_nothing():
+    ctrl, *_ = zeroed()
+    force, _ = ctrl.resolvable()
+    assert force == pytest.approx(5 * 0.63 * 0.149, rel=0.2)  # 5 filtered stds of the worst axis: ~0.47 N
+    running = ctrl.set_laws(laws(x=AxisLaw(LAW_FOLLOWER, damping=30.0)), np.eye(4), 1.0)
+    with pytest.raises(RequestError) as err:
+        ctrl.set_laws(laws(z=AxisLaw(LAW_COMPLIANT_MOVE, velocity=-0.01, force_limit=0.2)), np.eye(4), 1.0)
+    assert err.value.code == SET_CONTROL_FORCE_FAILED and err.value.axis == "z"
+    assert "below what the sensor resolves" in err.value.message and f"{force:.3g} N" in err.value.message
+    assert ctrl.move_id == running and ctrl.move_active and ctrl.laws[0].law == LAW_FOLLOWER
+    ctrl.set_laws(laws(z=AxisLaw(LAW_COMPLIANT_MOVE, velocity=-0.01, force_limit=1.0)), np.eye(4), 1.0)
+    # Without the check (noise_limit_sigmas 0) the same request is accepted, as before.
+    ctrl, *_ = zeroed(noise_limit_sigmas=0.0)
+    ctrl.set_laws(laws(z=AxisLaw(LAW_COMPLIANT_MOVE, velocity=-0.01, force_limit=0.2)), np.eye(4), 1.0)
+
+
+def test_the_deadband_follows_the_noise_so_a_follower_on_a_noisy_sensor_holds_still():
+    noise = np.array([2.0, 2.0, 2.0, 0.05, 0.05, 0.05])  # a current-based estimate, 500 Hz
+    follower = AxisLaw(LAW_FOLLOWER, damping=30.0)
+    travel = {}
+    for sigmas in (4.0, 0.0):
+        ctrl, rng, offset, t = zeroed(noise=noise, noise_deadband_sigmas=sigmas, follower_deadband_force=0.0,
+                                      min_velocity_linear=0.0, tare_max_force_spread=20.0)
+        ctrl.set_laws(laws(x=follower, y=follower, z=follower), np.eye(4), t)
+        v = []
+        for n in range(1000):
+            r = ctrl.update((offset + rng.normal(size=6) * noise).tolist(), t + n * DT, stamp=t + n * DT)
+            v.append(r.velocity[:3])
+        travel[sigmas] = np.abs(np.sum(v, axis=0) * DT).max()
+    # 2 s of 2 N noise (filtered std 0.3 N): the follower with the noise deadband moves a few millimetres
+    # (38 mm without: it wanders)
+    assert travel[4.0] < 0.004 and travel[0.0] > 10 * travel[4.0]
+    # and a real push still moves it
+    r = ctrl.update((offset + np.array([10.0, 0, 0, 0, 0, 0])).tolist(), t + 2.1, stamp=t + 2.1)
+    assert r.safety == SAFETY_OK
+
+
+def test_one_spike_over_the_limit_does_not_end_a_compliant_move_but_a_contact_does():
+    loop = ClosedLoop(ContactControl(load_settings({"tare_on_startup": False, "lp_filter_enabled": False})))
+    loop.start(laws(z=AxisLaw(LAW_COMPLIANT_MOVE, velocity=-0.01, force_limit=2.0)))
+    loop.run([0.0] * 6, 0.6)  # past force_limit_arm_time
+
+    def spike(t, pose):
+        return [0.0, 0.0, 5.0 if abs(t - 0.7) < DT / 2 else 0.0, 0.0, 0.0, 0.0]
+
+    loop.run(spike, 0.2)
+    assert loop.results[-1].move_active
+    loop.run([0.0, 0.0, 3.0, 0.0, 0.0, 0.0], 0.1)  # contact: 3 N on every sample
+    final = loop.results[-1]
+    assert not final.move_active and final.end_conditions[2] == END_FT_VIOLATION
+    assert final.end_conditions[:2] == [END_NONE, END_NONE]
+    # With force_limit_samples 1 (the fork) the same spike ends it.
+    loop = ClosedLoop(ContactControl(load_settings({"tare_on_startup": False, "lp_filter_enabled": False,
+                                                    "force_limit_samples": 1})))
+    loop.start(laws(z=AxisLaw(LAW_COMPLIANT_MOVE, velocity=-0.01, force_limit=2.0)))
+    loop.run([0.0] * 6, 0.6)
+    loop.run(spike, 0.2)
+    assert not loop.results[-1].move_active
+
+
+def test_noise_floor_limits_take_the_worst_axis():
+    floor = NoiseFloor.measure([0.1, 0.3, 0.2, 0.01, 0.02, 0.03], 100.0, 50, None)
+    assert floor.filtered == floor.std  # no filter
+    assert floor.resolvable(5.0) == pytest.approx((1.5, 0.15))
+
+
+def test_slow_noise_passes_the_filter_so_it_counts_whole():
+    # The Panda's F_ext at rest (92 Hz bag, fitted with fit_sensor): lag-1 0.97 on fz, almost all of it passes
+    # a 5 Hz filter; white noise at 92 Hz keeps sqrt(2 * 1.11 * 5 / 92) = 0.35 of its std.
+    assert filtered_fraction(92.0, 5.0, 0.97) > 0.9
+    assert filtered_fraction(92.0, 5.0, 0.0) == pytest.approx(0.347, abs=0.005)
+    rate, a = 92.0, 0.95
+    rng = np.random.default_rng(2)
+    x = np.zeros(6)
+    ctrl = ContactControl(load_settings({"lp_filter_delta_t": 1.0 / rate}))
+    t = 0.0
+    while ctrl.zeroing and t < 5.0:
+        x = a * x + np.sqrt(1 - a * a) * np.array([0.3, 0.3, 0.3, 0.03, 0.03, 0.03]) * rng.normal(size=6)
+        ctrl.update(x.tolist(), t, stamp=t)
+        t += 1.0 / rate
+    floor = ctrl.noise_floor
+    assert floor is not None
+    assert np.all(np.array(floor.filtered) > 0.6 * np.array(floor.std))  # not the white-noise 0.35
