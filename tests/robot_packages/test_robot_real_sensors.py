@@ -1,6 +1,7 @@
-"""The Panda as a franka_ros user runs it, against the emulated franka_ros with the errors fitted from a real
-Panda's F_ext: panda_custom's driver configuration sets franka_state_controller's publish rate, contact_control
-measures the estimate's noise floor while zeroing and refuses a force limit the estimate cannot resolve."""
+"""The Panda as a franka_ros user runs it, against the emulated franka_ros with the errors fitted from a
+real Panda's F_ext: panda_custom's driver configuration sets franka_state_controller's publish rate,
+contact_control measures the estimate's noise floor while zeroing and refuses a force limit the estimate
+cannot resolve."""
 
 from __future__ import annotations
 
