@@ -68,7 +68,8 @@ def test_the_deadband_follows_the_noise_so_a_follower_on_a_noisy_sensor_holds_st
     travel = {}
     for sigmas in (4.0, 0.0):
         ctrl, rng, offset, t = zeroed(noise=noise, noise_deadband_sigmas=sigmas, follower_deadband_force=0.0,
-                                      min_velocity_linear=0.0, tare_max_force_spread=20.0)
+                                      min_velocity_linear=0.0, tare_max_force_spread=20.0,
+                                      oscillation_reversals=0)
         ctrl.set_laws(laws(x=follower, y=follower, z=follower), np.eye(4), t)
         v = []
         for n in range(1000):
@@ -129,3 +130,29 @@ def test_slow_noise_passes_the_filter_so_it_counts_whole():
     floor = ctrl.noise_floor
     assert floor is not None
     assert np.all(np.array(floor.filtered) > 0.6 * np.array(floor.std))  # not the white-noise 0.35
+
+
+def test_the_zero_drift_is_measured_at_rest_and_re_tared_by_the_policy():
+    for limit, retared in ((0.0, False), (2.0, True)):
+        ctrl, rng, offset, t = zeroed(auto_tare_drift=limit)
+        assert ctrl.zero_drift is None
+        moved = offset + np.array([3.0, -1.0, 2.0, 0.0, 0.0, 0.0])  # the zero moved 3.7 N (after a press)
+        for n in range(400):  # 0.8 s at 500 Hz: not yet a whole 1 s window
+            ctrl.update((moved + rng.normal(size=6) * NOISE).tolist(), t + n * 0.002, stamp=t + n * 0.002)
+        assert ctrl.zero_drift is None
+        for n in range(400, 1200):
+            r = ctrl.update((moved + rng.normal(size=6) * NOISE).tolist(), t + n * 0.002, stamp=t + n * 0.002)
+        drift = np.array(ctrl.zero_drift)
+        if retared:
+            np.testing.assert_allclose(drift[:3], 0.0, atol=0.3)  # re-tared: the next window reads ~0
+            assert any("re-tared at rest: the zero had moved by 3." in note for note in ctrl.notes)  # 3.7 N
+            assert max(abs(f) for f in r.wrench[:3]) < 0.5
+        else:
+            np.testing.assert_allclose(drift[:3], [3.0, -1.0, 2.0], atol=0.15)
+            assert abs(r.wrench[0] - 3.0) < 0.5  # still there: the laws would feel 3 N
+    # A law running: no drift measured meanwhile (the arm is not at rest).
+    ctrl, rng, offset, t = zeroed()
+    ctrl.set_laws(laws(z=AxisLaw(LAW_FOLLOWER, damping=30.0)), np.eye(4), t)
+    for n in range(1000):
+        ctrl.update((offset + rng.normal(size=6) * NOISE).tolist(), t + n * 0.002, stamp=t + n * 0.002)
+    assert ctrl.zero_drift is None

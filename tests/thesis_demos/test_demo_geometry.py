@@ -114,3 +114,27 @@ def test_every_robot_package_has_demos_its_start_pose_and_scene_allow(package):
     # obstacle must at least be reachable by the compliant move from above.
     assert obstacle.size[0] / 2 > radius and obstacle.size[1] / 2 > radius
     assert g.compliant_max_travel > 0.045
+
+
+def test_the_contact_force_limit_is_per_driver_and_a_sensor_that_cannot_resolve_it_is_named():
+    from thesis_demos.geometry import DemoConfigError, DemoGeometry
+    from thesis_demos.main import unresolvable
+    from thesis_demos.scenarios import by_name
+
+    g = DemoGeometry.from_dict({"contact_force": {"limit": 0.5, "drivers": {"franka_ros": 1.5}}})
+    assert g.contact_force_limit == 0.5 and g.for_driver("ur_robot_driver") == g
+    franka = g.for_driver("franka_ros")
+    (move, hybrid) = by_name(["compliant_move_z", "hybrid"], franka)
+    assert move.laws["z"].force_limit == 1.5 and hybrid.laws["x"].force_limit == 1.5
+    assert "max force 1.5 N" in move.title
+    assert DemoGeometry.from_dict(g.as_dict()) == g and "contact_force" not in DemoGeometry().as_dict()
+    for bad in ({"limit": -1}, {"drivers": {"franka_ros": "x"}}, {"limits": 1}):
+        with pytest.raises(DemoConfigError, match="contact_force"):
+            DemoGeometry.from_dict({"contact_force": bad})
+    # What run_demos prints as [CANNOT]: the noise floor resolves 0.62 N, the thesis's limit is 0.5 N.
+    (thesis,) = by_name(["compliant_move_z"], g)
+    reason = unresolvable(thesis, (0.62, 0.2))
+    assert "resolves forces of 0.62 N" in reason and "stops at 0.5 N" in reason
+    assert unresolvable(move, (0.62, 0.2)) == "" and unresolvable(thesis, None) == ""
+    (follower,) = by_name(["follower_z"], g)
+    assert unresolvable(follower, (5.0, 5.0)) == ""  # no force limit

@@ -17,6 +17,7 @@ __all__ = [
     "END_NAMES",
     "END_NONE",
     "END_NO_FT_DATA",
+    "END_OSCILLATION",
     "EXCEEDED_ACTION_NAMES",
     "EXCEEDED_GRAVITY_COMPENSATION",
     "EXCEEDED_MOVE_AWAY",
@@ -67,6 +68,7 @@ END_MAX_TRAVEL = 2
 END_DIFF_VIOLATION = 3
 END_NO_FT_DATA = 4
 END_EXTERNAL_STOP = 5
+END_OSCILLATION = 6
 END_NAMES = {
     END_NONE: "none",
     END_FT_VIOLATION: "force/torque limit",
@@ -74,6 +76,7 @@ END_NAMES = {
     END_DIFF_VIOLATION: "force jump",
     END_NO_FT_DATA: "no F/T data",
     END_EXTERNAL_STOP: "external stop",
+    END_OSCILLATION: "oscillation",
 }
 
 # compliant_control_msgs/AxisLaw ACTION_*: what an axis does once the move ends on a force/torque limit

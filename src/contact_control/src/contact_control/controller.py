@@ -34,18 +34,23 @@ from contact_control.axes import (
     END_NAMES,
     END_NO_FT_DATA,
     END_NONE,
+    END_OSCILLATION,
     LAW_FOLLOWER,
     LAW_FORCE_TRACKING,
     LAW_NONE,
+    LAW_SPRING,
     SAFETY_NAN,
     SAFETY_OK,
     SAFETY_OVER_LIMIT,
     SAFETY_STALE,
     SAFETY_ZEROING,
 )
+from contact_control.drift import ZeroDrift
 from contact_control.exceeded import ExceededReaction
 from contact_control.laws import AxisLaw, ForceWindow, check_end, law_velocity, shape_velocity
+from contact_control.loop_gain import GainBound
 from contact_control.noise_floor import NoiseFloor
+from contact_control.oscillation import OscillationWatch, halved
 from contact_control.params import ContactControlSettings
 from contact_control.preprocess import PreprocessError, WrenchPreprocessor, as_rows, is_finite6
 from contact_control.rate import SamplePeriod
@@ -221,8 +226,17 @@ class ContactControl:
             if s.tare_on_startup and s.tare_window > 0.0 else None
         )
         self._floor_noise: NoiseFloor | None = None
+        self._gain_bound = GainBound(s.loop_gain_delay, s.command_latency, s.spring_output_scale,
+                                     s.contact_stiffness)
         self._limit_samples = int(s.force_limit_samples)
         self._over = [0] * 6  # per axis: wrenches in a row over its force limit
+        self._watch = (OscillationWatch(int(s.oscillation_reversals), s.oscillation_window)
+                       if s.oscillation_reversals > 0 else None)
+        self._halved = [False] * 6  # per axis: the watchdog has halved its gain in this move
+        self._requested: list[AxisLaw] = []  # the laws as last requested (the watchdog may lower them)
+        self._drift = (ZeroDrift(s.drift_window, s.tare_max_force_spread, s.tare_max_torque_spread)
+                       if s.drift_window > 0.0 else None)
+        self._drift_next = 0.0  # when the drift watch takes its next sample [s]
         self._last_raw: Sequence[float] | None = None
         self._last_R: Any = None
         self.last_result = self._result(0.0, SAFETY_STALE, "no wrench yet")
@@ -276,6 +290,13 @@ class ContactControl:
         if self._floor_noise is None or sigmas <= 0.0:
             return 0.0, 0.0
         return self._floor_noise.resolvable(sigmas)
+
+    def bound_gains(self, laws: Sequence[AxisLaw]) -> tuple[list[AxisLaw], list[str]]:
+        """The laws with their loop gains within what the sensor's measured rate (`lp_filter_delta_t` until
+        measured) and the command latency keep stable, and a note per lowered gain (see `loop_gain`)."""
+        period = self._rate.period or self.settings.lp_filter_delta_t
+        cutoff = self.preprocessor.cutoff if self.settings.lp_filter_enabled else None
+        return self._gain_bound.limit(laws, period, cutoff)
 
     def check_resolvable(self, laws: Sequence[AxisLaw]) -> None:
         """Refuses limits the sensor cannot tell from its noise.
@@ -334,10 +355,16 @@ class ContactControl:
         if self._latched:
             raise RequestError(FAILURE, f"safety latched ({self._latch_message}); call reset first")
         self.check_resolvable(laws)
+        if self._move_active and laws == self._requested:
+            return self._move_id  # a re-sent request (GUI Apply held, a script in a loop): nothing changes
+        self._requested = laws
+        if self._drift is not None:
+            self._drift.restart()
         self._over = [0] * 6
+        self._halved = [False] * 6
+        if self._watch is not None:
+            self._watch.clear()
         if self._move_active and any(law.law for law in laws):
-            if laws == self._laws:  # a re-sent request (GUI Apply held, a script in a loop): nothing changes
-                return self._move_id
             return self._change_laws(laws, t)
         if self._move_active:
             self._end_move(-1, END_EXTERNAL_STOP, False, "replaced by a new request")
@@ -459,6 +486,9 @@ class ContactControl:
             wrench, R_world_sensor = self._last_raw, self._last_R
         bias = self.preprocessor.tare(wrench, R_world_sensor)
         self._tare_pending = False
+        if self._drift is not None:  # the zero is here now
+            self._drift.restart()
+            self._drift.drift = (0.0,) * 6
         return bias
 
     def reset_safety(self) -> bool:
@@ -529,6 +559,9 @@ class ContactControl:
         if not self._move_active:
             if self._reaction.active:
                 return self._react(t, w)
+            if self._drift is not None and t >= self._drift_next:
+                self._drift_next = t + 0.02
+                self._watch_drift(wrench, R_world_sensor, t)
             return self._result(t, SAFETY_OK, "")
         travel = self._travel
         if eef_pose is not None:
@@ -563,6 +596,13 @@ class ContactControl:
             v[i] = shape_velocity(
                 law_velocity(laws[i], tuning[i], w[i], travel[i]), v[i], tuning[i], dt, floor[i]
             )
+        watch = self._watch
+        if watch is not None:
+            for i in self._active:
+                if watch.add(i, t, v[i], tuning[i].min_velocity):
+                    stopped = self._oscillating(t, i)
+                    if stopped is not None:
+                        return stopped
         if not all(armed):
             if self._from_rest is None:
                 self._from_rest = t
@@ -684,6 +724,50 @@ class ContactControl:
             self._armed = [False] * 6
             self._from_rest = t
         return self._result(t, safety, message)
+
+    @property
+    def zero_drift(self) -> tuple[float, ...] | None:
+        """How far the zero has moved since the bias was set, measured at rest [N, Nm], sensor frame (None:
+        not yet measured)."""
+        return None if self._drift is None else self._drift.drift
+
+    def _watch_drift(self, wrench: Sequence[float], R_world_sensor: Any, t: float) -> None:
+        """A sample at rest for the drift watch; re-tares when the policy says so."""
+        assert self._drift is not None
+        try:
+            estimate = self.preprocessor.bias_estimate(wrench, R_world_sensor)
+        except PreprocessError:  # no orientation for the tool's weight: no estimate
+            return
+        bias = self.preprocessor.bias
+        drift = self._drift.add(estimate, bias, t)
+        limit = self.settings.auto_tare_drift
+        if drift is None or limit <= 0.0 or self._drift.force <= limit:
+            return
+        moved = self._drift.force
+        self.preprocessor.set_bias([b + d for b, d in zip(bias, drift, strict=True)], at_rest=True)
+        self._drift.drift = (0.0,) * 6
+        self.notes.append(f"re-tared at rest: the zero had moved by {moved:.3g} N (auto_tare_drift "
+                          f"{limit:g} N)")
+
+    def _oscillating(self, t: float, axis: int) -> CycleResult | None:
+        """The watchdog saw `axis` oscillate: its gain is halved the first time (the move goes on), the move
+        ends (OSCILLATION, every axis holds) the second."""
+        assert self._watch is not None
+        law, name = self._laws[axis], AXES[axis]
+        what = (f"axis {name}: its velocity reversed {self._watch.reversals} times within "
+                f"{self._watch.window:g} s (oscillation_reversals)")
+        lower = None if self._halved[axis] else halved(law)
+        self._watch.clear(axis)
+        if lower is None:
+            self._end_move(axis, END_OSCILLATION, False, f"{what}: stopped, the gain was already lowered")
+            return self._hold(t, SAFETY_OK, "")
+        laws = list(self._laws)
+        laws[axis] = lower
+        self._laws = laws
+        self._halved[axis] = True
+        k = f", k {law.stiffness:g} -> {lower.stiffness:g}" if law.law == LAW_SPRING else ""
+        self.notes.append(f"{what}: gain halved (b {law.damping:g} -> {lower.damping:g}{k})")
+        return None
 
     def _end_and_hold(self, t: float, axis: int, condition: int) -> CycleResult:
         law, name = self._laws[axis], AXES[axis]

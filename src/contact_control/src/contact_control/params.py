@@ -140,6 +140,30 @@ class ContactControlSettings:
         2.0, ge=1.0, doc="a force/torque limit ends a move once exceeded on this many wrenches in a row (one "
         "spike does not; 1: the first, as the fork)"
     )
+    command_latency: float = _nonneg(
+        0.01, "s", "the command path's latency: the jogger's period, the driver, the arm's servo (the laws' "
+        "gains are bounded with it; README, Loop gain)"
+    )
+    loop_gain_delay: float = _nonneg(
+        0.5, "", "a spring's gain (scale x k) and force tracking's (contact_stiffness / b) times the loop's "
+        "delay (sensor period + command_latency, + the filter's delay on force) at most this; a request over "
+        "it is lowered and the answer says so (0: no bound)"
+    )
+    contact_stiffness: float = _nonneg(
+        0.0, "N/m", "the surfaces force tracking presses on, to bound its gain (0: unknown, not bounded)"
+    )
+    oscillation_reversals: float = _nonneg(
+        6.0, "", "an axis whose commanded velocity reverses this often within `oscillation_window` "
+        "oscillates: its gain is halved once, then the move stops (OSCILLATION); 0: no watchdog"
+    )
+    oscillation_window: float = _pos(2.0, "s", "the watchdog's window")
+    drift_window: float = _nonneg(
+        1.0, "s", "at rest (no law, no exceeded action) the zero's drift is measured over windows this long "
+        "of steady wrenches (the tare spreads), sampled at 50 Hz; 0: not watched"
+    )
+    auto_tare_drift: float = _nonneg(
+        0.0, "N", "re-tare at rest once the zero has drifted by more than this (0: never; `~tare` on request)"
+    )
     tool_mass: float = _nonneg(
         0.0, "kg", "payload below the sensor, gravity-compensated (the robot package's description.args "
         "`--tool-mass`)"

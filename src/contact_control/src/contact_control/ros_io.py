@@ -275,6 +275,9 @@ class ContactControlRos:
         floor = self._stage.ctrl.noise_floor
         if floor is not None and not msg.noise_std:
             msg.noise_std, msg.noise_filtered = list(floor.std), list(floor.filtered)
+        drift = self._stage.ctrl.zero_drift
+        if drift is not None:
+            msg.zero_drift = list(drift)
         fill_status_words(msg, r)
         self._status_pub.publish(msg)
 

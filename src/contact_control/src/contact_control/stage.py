@@ -233,7 +233,7 @@ class ContactStage:
         (accepted, code, the laws in words or the reason for refusing)."""
         validate = validate_laws_request if per_axis else validate_request
         try:
-            laws = validate(req, self.limits)
+            laws, limited = self.ctrl.bound_gains(validate(req, self.limits))
             move_id = self.ctrl.set_laws(laws, None, t)
         except RequestError as err:
             self._request_note = f"last request refused (code {err.code}): {err.message}"
@@ -242,6 +242,8 @@ class ContactStage:
         self._idle_zeros = int(self.settings.idle_zero_count)
         self.ended = True  # a blocking caller of a replaced move answers now
         message = describe_laws(move_id, laws)
+        if limited:
+            message += "; gains lowered for the sensor's rate: " + ", ".join(limited)
         if self.ctrl.zeroing:
             message += (
                 "; the sensor is still being zeroed (tare_on_startup): the laws act once ~status shows "

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 from typing import Any
 
 import yaml
@@ -51,6 +51,30 @@ class DemoConfigError(ValueError):
     """A demos.yaml (or the scene's obstacle) that cannot be used; the message names the key."""
 
 
+def _positive(value: Any, name: str) -> float:
+    number = isinstance(value, (int, float)) and not isinstance(value, bool)
+    if not number or not math.isfinite(value) or value <= 0:
+        raise DemoConfigError(f"{name}: expected a positive number, got {value!r}")
+    return float(value)
+
+
+def _contact_force(section: Any) -> dict[str, Any]:
+    """demos.yaml's contact_force section: {limit: N, drivers: {profile: N}}."""
+    if section is None:
+        return {}
+    if not isinstance(section, Mapping) or set(section) - {"limit", "drivers"}:
+        raise DemoConfigError(f"contact_force: expected a mapping with limit and drivers, got {section!r}")
+    values: dict[str, Any] = {}
+    if "limit" in section:
+        values["contact_force_limit"] = _positive(section["limit"], "contact_force.limit")
+    drivers = section.get("drivers") or {}
+    if not isinstance(drivers, Mapping):
+        raise DemoConfigError(f"contact_force.drivers: expected {{profile: limit}}, got {drivers!r}")
+    values["driver_force_limits"] = tuple(
+        (str(name), _positive(limit, f"contact_force.drivers.{name}")) for name, limit in drivers.items())
+    return values
+
+
 @dataclass(frozen=True)
 class DemoGeometry:
     """The arm-dependent numbers of the four demonstrations (defaults: the thesis-sized ones).
@@ -66,6 +90,10 @@ class DemoGeometry:
         hybrid_direction: Sign along X of the hybrid compliant move.
         hybrid_speed: Its V_desired magnitude [m/s].
         hybrid_travel: Its max path deviation [m], where it must end.
+        contact_force_limit: The compliant move's and the hybrid's force limit [N], the stop on contact (the
+            thesis's 0.5 N).
+        driver_force_limits: (driver profile, limit [N]) pairs: the limit with that driver's sensor
+            (`make demo DRIVER=...`), which resolves less than the simulation's wrist sensor.
     """
 
     follower_push_force: float = 5.0
@@ -78,6 +106,13 @@ class DemoGeometry:
     hybrid_direction: int = -1
     hybrid_speed: float = 0.05
     hybrid_travel: float = 0.30
+    contact_force_limit: float = 0.5
+    driver_force_limits: tuple[tuple[str, float], ...] = ()
+
+    def for_driver(self, driver: str) -> DemoGeometry:
+        """These numbers with the force limit for `driver`'s sensor ("" or not listed: unchanged)."""
+        limits = dict(self.driver_force_limits)
+        return replace(self, contact_force_limit=limits[driver]) if driver in limits else self
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any] | None) -> DemoGeometry:
@@ -99,10 +134,10 @@ class DemoGeometry:
             "spring": {"direction": "spring_direction", "push_force": "spring_push_force"},
             "hybrid": {"direction": "hybrid_direction", "speed": "hybrid_speed", "travel": "hybrid_travel"},
         }
-        unknown = set(data) - set(layout)
+        unknown = set(data) - set(layout) - {"contact_force"}
         if unknown:
-            raise DemoConfigError(f"unknown sections {sorted(unknown)}; known: {list(layout)}")
-        values: dict[str, Any] = {}
+            raise DemoConfigError(f"unknown sections {sorted(unknown)}; known: {[*layout, 'contact_force']}")
+        values: dict[str, Any] = _contact_force(data.get("contact_force"))
         for section, keys in layout.items():
             got = data.get(section) or {}
             if not isinstance(got, Mapping):
@@ -127,9 +162,13 @@ class DemoGeometry:
                     values[attr] = float(value)
         return cls(**values)
 
-    def as_dict(self) -> dict[str, dict[str, float]]:
+    def as_dict(self) -> dict[str, dict[str, Any]]:
         """The demos.yaml mapping of these numbers (inverse of :meth:`from_dict`)."""
-        out: dict[str, dict[str, float]] = {}
+        out: dict[str, dict[str, Any]] = {}
+        if self.contact_force_limit != DemoGeometry.contact_force_limit or self.driver_force_limits:
+            out["contact_force"] = {"limit": self.contact_force_limit}  # only when not the thesis's
+        if self.driver_force_limits:
+            out["contact_force"]["drivers"] = dict(self.driver_force_limits)
         prefixes = {"follower_": "follower", "compliant_": "compliant_move", "spring_": "spring",
                     "hybrid_": "hybrid"}
         for f in fields(self):

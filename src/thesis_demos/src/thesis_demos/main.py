@@ -7,6 +7,7 @@ import os
 import sys
 import time
 from collections.abc import Sequence
+from typing import Any
 
 __all__ = ["main"]
 
@@ -24,9 +25,30 @@ def _args(argv: Sequence[str]) -> argparse.Namespace:
     parser.add_argument("--only", nargs="*", help="run only these demos (follower_z compliant_move_z ...)")
     parser.add_argument("--sensor-frame", default="ft_sensor")
     parser.add_argument("--wrench-topic", default="/wrench", help="the wrist wrench (a real driver's topic)")
+    parser.add_argument("--driver", default="", help="the driver profile behind the stack (demos.yaml's "
+                        "contact_force.drivers may set its force limit)")
     parser.add_argument("--base-frame", default="", help="default: contact_control's ~fixed_frame")
     parser.add_argument("--timeout", type=float, default=60.0, help="seconds to wait for the stack")
     return parser.parse_args(argv)
+
+
+def unresolvable(scenario: Any, resolvable: tuple[float, float] | None) -> str:
+    """Why the sensor cannot do `scenario` ("" if it can): a force or torque limit below what it resolves."""
+    if resolvable is None:
+        return ""
+    force, torque = resolvable
+    laws = list(scenario.laws.values())
+    if scenario.follow_up:
+        laws += list(scenario.follow_up.laws.values())
+    for law in laws:
+        if 0.0 < law.force_limit < force:
+            return (f"the sensor resolves forces of {force:.2g} N and more (5 filtered noise stds at rest, "
+                    f"contact_control's noise floor); this demonstration stops at {law.force_limit:g} N: "
+                    "raise demos.yaml's contact_force (drivers: {<profile>: N})")
+        if 0.0 < law.torque_limit < torque:
+            return (f"the sensor resolves torques of {torque:.2g} Nm and more; this demonstration stops at "
+                    f"{law.torque_limit:g} Nm")
+    return ""
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -34,7 +56,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     argv = rospy.myargv(sys.argv if argv is None else list(argv))[1:]
     args = _args(argv)
-    from thesis_demos.analysis import judge
+    from thesis_demos.analysis import Verdict, judge
     from thesis_demos.geometry import DemoConfigError, robot_setup
     from thesis_demos.plotting import plot
     from thesis_demos.report import markdown
@@ -43,7 +65,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     try:
         setup = robot_setup(args.robot, args.demos_config)
-        scenarios = by_name(args.only, setup.geometry)
+        scenarios = by_name(args.only, setup.geometry.for_driver(args.driver))
     except (DemoConfigError, KeyError) as exc:
         print(f"run_demos: {exc}", file=sys.stderr, flush=True)
         return 2
@@ -60,10 +82,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         for name, reason in cannot.items():
             if any(s.name == name for s in scenarios):
                 print(f"[CANNOT] {name}: this arm cannot do it as configured: {reason}", flush=True)
+    resolvable = runner.resolvable()
     for scenario in scenarios:
         if scenario.name in cannot:
             continue
-        recording = runner.run(scenario, args.sensor_frame)
+        reason = unresolvable(scenario, resolvable)
+        if reason:  # the sensor cannot tell this demonstration's force limit from its noise
+            cannot[scenario.name] = reason
+            print(f"[CANNOT] {scenario.name}: {reason}", flush=True)
+            continue
+        try:
+            recording = runner.run(scenario, args.sensor_frame)
+        except RuntimeError as exc:  # a refused request: the reason, not a traceback
+            print(f"[FAIL] {scenario.name}: {exc}", flush=True)
+            results.append((scenario, Verdict(False, str(exc), {}), ""))
+            continue
         verdict = judge(scenario, recording)
         png = f"{scenario.name}.png"
         plot(scenario, recording, verdict, os.path.join(args.output, png))

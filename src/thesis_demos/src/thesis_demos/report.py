@@ -29,7 +29,6 @@ def markdown(robot: str, results: Sequence[tuple[Scenario, Verdict, str]], secon
             "|---|---|",
             *(f"| {name} | {value:.4g} |" for name, value in verdict.figures.items()),
             "",
-            f"![{scenario.name}]({png})",
-            "",
+            *([f"![{scenario.name}]({png})", ""] if png else []),
         ]
     return "\n".join(lines)

@@ -326,6 +326,23 @@ class DemoRunner:
         if not response.success:
             raise RuntimeError(f"{scenario.name}: contact_control refused the request (see its ~status)")
 
+    def resolvable(self, timeout: float = 10.0) -> tuple[float, float] | None:
+        """The smallest force [N] and torque [Nm] limits contact_control accepts (its noise floor, measured
+        while zeroing, times its noise_limit_sigmas); None when it reports no noise floor (not zeroed, or an
+        older node)."""
+        cc = self.names.contact_control
+        sigmas = float(rospy.get_param(f"{cc}/noise_limit_sigmas", 5.0))
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline and not rospy.is_shutdown():
+            with self._status_lock:
+                status = self._last_status
+            if status is not None and len(status.noise_filtered) == 6:
+                return sigmas * max(status.noise_filtered[:3]), sigmas * max(status.noise_filtered[3:])
+            if status is not None and status.safety != 5:  # zeroed (not SAFETY_ZEROING) without a floor
+                return None
+            time.sleep(0.05)
+        return None
+
     def _force(self, axis: str) -> float | None:
         """The controller's latest force [N] along `axis` (x, y or z; control frame), None before a status."""
         with self._status_lock:

@@ -106,14 +106,15 @@ def build_scenarios(geometry: DemoGeometry | None = None) -> tuple[Scenario, ...
         Scenario(
             name="compliant_move_z",
             title=(
-                "Compliant move on Z toward an obstacle (max force 0.5 N, max torque 0.5 Nm), then move away"
+                f"Compliant move on Z toward an obstacle (max force {g.contact_force_limit:g} N, max torque "
+                "0.5 Nm), then move away"
             ),
             laws={
                 "z": AxisLaw(
                     COMPLIANT_MOVE,
                     damping=30.0,
                     velocity=g.compliant_direction * g.compliant_speed,
-                    force_limit=0.5,
+                    force_limit=g.contact_force_limit,
                     torque_limit=0.5,
                     max_travel=g.compliant_max_travel,
                 )
@@ -142,7 +143,7 @@ def build_scenarios(geometry: DemoGeometry | None = None) -> tuple[Scenario, ...
                     COMPLIANT_MOVE,
                     damping=30.0,
                     velocity=g.hybrid_direction * g.hybrid_speed,
-                    force_limit=0.5,
+                    force_limit=g.contact_force_limit,
                     torque_limit=0.5,
                     max_travel=g.hybrid_travel,
                 ),
