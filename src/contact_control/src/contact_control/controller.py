@@ -487,8 +487,7 @@ class ContactControl:
         bias = self.preprocessor.tare(wrench, R_world_sensor)
         self._tare_pending = False
         if self._drift is not None:  # the zero is here now
-            self._drift.restart()
-            self._drift.drift = (0.0,) * 6
+            self._drift.rezeroed()
         return bias
 
     def reset_safety(self) -> bool:
@@ -745,7 +744,7 @@ class ContactControl:
             return
         moved = self._drift.force
         self.preprocessor.set_bias([b + d for b, d in zip(bias, drift, strict=True)], at_rest=True)
-        self._drift.drift = (0.0,) * 6
+        self._drift.rezeroed()
         self.notes.append(f"re-tared at rest: the zero had moved by {moved:.3g} N (auto_tare_drift "
                           f"{limit:g} N)")
 

@@ -22,8 +22,6 @@ class ZeroDrift:
         self._steady = SteadyZero(window, max_force_spread, max_torque_spread)
         #: The last drift measured [N, Nm] per sensor axis (None before the first steady window).
         self.drift: tuple[float, ...] | None = None
-        #: When it was measured [s].
-        self.measured_at = 0.0
 
     def restart(self) -> None:
         """Not at rest any more (a law or an exceeded action runs): the window starts again."""
@@ -35,9 +33,13 @@ class ZeroDrift:
         if mean is None:
             return None
         self.drift = tuple(m - b for m, b in zip(mean, bias, strict=True))
-        self.measured_at = t
         self.restart()
         return self.drift
+
+    def rezeroed(self) -> None:
+        """The bias was just set to the current reading (a tare): no drift, and a new window."""
+        self.restart()
+        self.drift = (0.0,) * 6
 
     @property
     def force(self) -> float:

@@ -42,8 +42,8 @@ def unresolvable(scenario: Any, resolvable: tuple[float, float] | None) -> str:
         laws += list(scenario.follow_up.laws.values())
     for law in laws:
         if 0.0 < law.force_limit < force:
-            return (f"the sensor resolves forces of {force:.2g} N and more (5 filtered noise stds at rest, "
-                    f"contact_control's noise floor); this demonstration stops at {law.force_limit:g} N: "
+            return (f"the sensor resolves forces of {force:.2g} N and more (contact_control's noise floor "
+                    f"times its noise_limit_sigmas); this demonstration stops at {law.force_limit:g} N: "
                     "raise demos.yaml's contact_force (drivers: {<profile>: N})")
         if 0.0 < law.torque_limit < torque:
             return (f"the sensor resolves torques of {torque:.2g} Nm and more; this demonstration stops at "

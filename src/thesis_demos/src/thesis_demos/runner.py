@@ -25,6 +25,7 @@ from compliant_control_msgs.srv import (
     PushEEF,
     PushEEFRequest,
 )
+from contact_control.noise_floor import NoiseFloor
 from contact_control.params import ContactControlSettings
 from geometry_msgs.msg import PoseStamped, WrenchStamped
 from std_srvs.srv import Trigger
@@ -330,18 +331,25 @@ class DemoRunner:
         """The smallest force [N] and torque [Nm] limits contact_control accepts (its noise floor, measured
         while zeroing, times its noise_limit_sigmas); None when it reports no noise floor (not zeroed, or an
         older node)."""
-        cc = self.names.contact_control
-        sigmas = float(rospy.get_param(f"{cc}/noise_limit_sigmas", 5.0))
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline and not rospy.is_shutdown():
+        sigmas = float(rospy.get_param(f"{self.names.contact_control}/noise_limit_sigmas",
+                                        ContactControlSettings.noise_limit_sigmas))
+
+        def reported() -> bool:  # a noise floor, or zeroed without one
             with self._status_lock:
                 status = self._last_status
-            if status is not None and len(status.noise_filtered) == 6:
-                return sigmas * max(status.noise_filtered[:3]), sigmas * max(status.noise_filtered[3:])
-            if status is not None and status.safety != 5:  # zeroed (not SAFETY_ZEROING) without a floor
-                return None
-            time.sleep(0.05)
-        return None
+            return status is not None and (len(status.noise_filtered) == 6
+                                           or status.safety != ContactControlStatus.SAFETY_ZEROING)
+
+        try:
+            self._wait(reported, timeout, "contact_control's zeroing")
+        except TimeoutError:
+            return None
+        with self._status_lock:
+            status = self._last_status
+        if status is None or len(status.noise_filtered) != 6:
+            return None
+        floor = NoiseFloor(tuple(status.noise_std), 0.0, 0, tuple(status.noise_filtered))
+        return floor.resolvable(sigmas)
 
     def _force(self, axis: str) -> float | None:
         """The controller's latest force [N] along `axis` (x, y or z; control frame), None before a status."""
