@@ -275,7 +275,11 @@ def test_nan_wrench_zeroes_output_in_the_same_cycle_and_resumes(bad):
 def test_wrench_over_the_global_limit_latches_until_reset():
     ctrl = controller()
     t = run_follower(ctrl)
-    result = ctrl.update(unit(2, 30.0), t)
+    before = ctrl.last_result.velocity
+    spike = ctrl.update(unit(2, 30.0), t)  # one wrench over: a spike (force_limit_samples 2), nothing latches
+    assert spike.safety == SAFETY_OK and spike.move_active and spike.velocity == before
+    t += DT
+    result = ctrl.update(unit(2, 30.0), t)  # the second in a row: latched
     assert result.velocity == [0.0] * 6 and result.safety == SAFETY_OVER_LIMIT and "reset" in result.message
     assert not result.move_active and result.end_conditions[2] == END_FT_VIOLATION and not ctrl.end_ok
     result = ctrl.update(unit(2, 9.0), t + DT)  # back in range: still latched
@@ -285,6 +289,10 @@ def test_wrench_over_the_global_limit_latches_until_reset():
     assert ctrl.check_stale(t + 1.0).safety == SAFETY_OVER_LIMIT  # silence does not hide the latch
     assert ctrl.reset_safety() and ctrl.update(unit(2, 9.0), t + 2 * DT).safety == SAFETY_OK
     run_follower(ctrl)
+    # force_limit_samples 1: the first wrench over latches, as the fork did.
+    ctrl = controller(force_limit_samples=1)
+    t = run_follower(ctrl)
+    assert ctrl.update(unit(2, 30.0), t).safety == SAFETY_OVER_LIMIT
 
 
 def test_stale_wrench_zeroes_output_then_ends_the_move():

@@ -81,3 +81,24 @@ def test_a_resent_request_does_not_undo_the_watchdog():
     assert loop.ctrl.set_laws(follower, loop.pose, loop.t) == move  # the same request again: nothing changes
     assert loop.ctrl.laws[2].damping == 60.0
     assert DT > 0
+
+
+@pytest.mark.parametrize("noise_aware", [True, False])
+def test_a_spring_held_against_a_push_on_a_noisy_estimate_is_not_an_oscillation(noise_aware, monkeypatch):
+    """Held by a push, the spring's force error crosses zero with the sensor's noise (3.6 N, a current
+    estimate): velocity reversals within what that noise gives are not counted (contrast: without that
+    floor the watchdog halves the gain on noise, as it did on the emulated CB3)."""
+    if not noise_aware:
+        monkeypatch.setattr("contact_control.controller.WATCH_NOISE_SIGMAS", 0.0)
+    rng = np.random.default_rng(4)
+    noise = np.array([3.6, 3.6, 3.6, 0.3, 0.3, 0.3])
+    loop = ClosedLoop(controller(tare_on_startup=True, lp_filter_delta_t=DT))
+    loop.run(lambda t, pose: (rng.normal(size=6) * noise).tolist(), 0.4)  # zeroed: the noise floor
+    assert loop.ctrl.noise_floor is not None
+    loop.start(laws(x=SPRING))
+    loop.run(lambda t, pose: ([8.0, 0, 0, 0, 0, 0] + rng.normal(size=6) * noise).tolist(), 3.0)
+    halved = [note for note in loop.ctrl.notes if "gain halved" in note]
+    if noise_aware:
+        assert loop.ctrl.move_active and loop.ctrl.laws[0] == SPRING and not halved
+    else:
+        assert halved or not loop.ctrl.move_active

@@ -29,9 +29,9 @@ from robot_setup.generate import (
 UR3 = RobotSpec("ur3", "ur_description/urdf/ur3_robot.urdf", "tool0")
 ARGV = ["--name", UR3.name, "--urdf", UR3.urdf, "--tip", UR3.tip]
 HARDWARE = {"config/contact_control_hardware.yaml", "config/jog_arm_hardware.yaml", "launch/hardware.launch"}
-# What DRIVER may change besides the hardware files: the README (the recorded command, *Real robot*) and
-# package.xml (the command in its description).
-DRIVER_DEPENDENT = HARDWARE | {"README.md", "package.xml"}
+# What DRIVER may change besides the hardware files: the README (the recorded command, *Real robot*),
+# package.xml (the command in its description) and demos.yaml (the contact force with that driver's sensor).
+DRIVER_DEPENDENT = HARDWARE | {"README.md", "package.xml", "config/demos.yaml"}
 
 
 @pytest.fixture(scope="module")

@@ -116,6 +116,12 @@ def test_every_robot_package_has_demos_its_start_pose_and_scene_allow(package):
     assert g.compliant_max_travel > 0.045
 
 
+def floor(filtered_force: float, raw: float = 1.0):
+    from contact_control.noise_floor import NoiseFloor
+
+    return NoiseFloor((raw,) * 6, 0.0, 0, (filtered_force,) * 3 + (0.04,) * 3)
+
+
 def test_the_contact_force_limit_is_per_driver_and_a_sensor_that_cannot_resolve_it_is_named():
     from thesis_demos.geometry import DemoConfigError, DemoGeometry
     from thesis_demos.main import unresolvable
@@ -133,8 +139,18 @@ def test_the_contact_force_limit_is_per_driver_and_a_sensor_that_cannot_resolve_
             DemoGeometry.from_dict({"contact_force": bad})
     # What run_demos prints as [CANNOT]: the noise floor resolves 0.62 N, the thesis's limit is 0.5 N.
     (thesis,) = by_name(["compliant_move_z"], g)
-    reason = unresolvable(thesis, (0.62, 0.2))
+    reason = unresolvable(thesis, floor(0.124), 5.0)
     assert "resolves forces of 0.62 N" in reason and "stops at 0.5 N" in reason
-    assert unresolvable(move, (0.62, 0.2)) == "" and unresolvable(thesis, None) == ""
-    (follower,) = by_name(["follower_z"], g)
-    assert unresolvable(follower, (5.0, 5.0)) == ""  # no force limit
+    assert unresolvable(move, floor(0.124), 5.0) == "" and unresolvable(thesis, None, 5.0) == ""
+    assert unresolvable(thesis, floor(0.124), 0.0) == ""  # noise_limit_sigmas 0: nothing checked
+    # A current estimate (1.05 N after the filter, resolves 5.3 N): the follower's 5 N push is in its noise,
+    # and force tracking's +-1.5 N is inside the +-2.1 N its input wanders; the e-series' 0.24 N is not.
+    (follower, surface) = by_name(["follower_z", "surface_following"], g)
+    assert "pushes with 5 N, within its noise" in unresolvable(follower, floor(1.05), 5.0)
+    assert "wanders +-2.1 N" in unresolvable(surface, floor(1.05), 5.0)
+    assert unresolvable(follower, floor(0.24), 5.0) == "" and unresolvable(surface, floor(0.24), 5.0) == ""
+    # The spring's 15 N push plus 3 raw stds of a 4 N-noise estimate reaches the 25 N global limit.
+    (spring,) = by_name(["spring_x"], g)
+    assert "reaches contact_control's 25 N global limit" in unresolvable(spring, floor(1.05, raw=4.0), 5.0)
+    assert unresolvable(spring, floor(1.05, raw=4.0), 5.0, global_force=40.0) == ""
+    assert unresolvable(spring, floor(0.24, raw=0.63), 5.0) == ""

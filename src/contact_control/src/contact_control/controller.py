@@ -61,6 +61,9 @@ from contact_control.zeroing import SteadyZero
 __all__ = ["AxisState", "ContactControl", "CycleResult"]
 
 _ZEROS = (0.0,) * 6
+#: Filtered noise stds of force a velocity reversal must exceed to count for the watchdog (noise
+#: crosses 3 stds about once in 20 independent samples: ~2 s of a 5 Hz filter's output).
+WATCH_NOISE_SIGMAS = 3.0
 _NO_TRAVEL = (LAW_FOLLOWER, LAW_FORCE_TRACKING)  # laws that need no travel unless they have a max travel
 
 
@@ -220,21 +223,20 @@ class ContactControl:
         self._last_rx: float | None = None
         self._last_t: float | None = None
         self._tare_pending = s.tare_on_startup
-        self._zeroing = (
-            SteadyZero(s.tare_window, s.tare_max_force_spread, s.tare_max_torque_spread,
-                       int(s.tare_min_samples))
-            if s.tare_on_startup and s.tare_window > 0.0 else None
-        )
+        self._zeroing = self._new_zeroing() if s.tare_on_startup else None
         self._floor_noise: NoiseFloor | None = None
         self._gain_bound = GainBound(s.loop_gain_delay, s.command_latency, s.spring_output_scale,
                                      s.contact_stiffness)
         self._limit_samples = int(s.force_limit_samples)
         self._over = [0] * 6  # per axis: wrenches in a row over its force limit
+        self._over_global = 0  # wrenches in a row over a global limit
+        self._watch_floor = [t.min_velocity for t in self._tuning]
         self._watch = (OscillationWatch(int(s.oscillation_reversals), s.oscillation_window)
                        if s.oscillation_reversals > 0 else None)
         self._halved = [False] * 6  # per axis: the watchdog has halved its gain in this move
         self._requested: list[AxisLaw] = []  # the laws as last requested (the watchdog may lower them)
-        self._drift = (ZeroDrift(s.drift_window, s.tare_max_force_spread, s.tare_max_torque_spread)
+        self._drift = (ZeroDrift(s.drift_window, s.tare_max_force_spread, s.tare_max_torque_spread,
+                                 s.tare_spread_sigmas)
                        if s.drift_window > 0.0 else None)
         self._drift_next = 0.0  # when the drift watch takes its next sample [s]
         self._last_raw: Sequence[float] | None = None
@@ -401,6 +403,7 @@ class ContactControl:
         self._diff_axes = tuple(i for i in self._active if self._diff[i] > 0.0)
         self._needs_travel = any(law.law not in _NO_TRAVEL or law.max_travel > 0.0 for law in laws if law.law)
         self._floor = [law.law != LAW_FORCE_TRACKING for law in laws]
+        self._watch_floor_update()
 
     def _change_laws(self, laws: list[AxisLaw], t: float | None) -> int:
         """Bumpless re-configuration of a running move: an axis that keeps its law type keeps its velocity,
@@ -490,6 +493,31 @@ class ContactControl:
             self._drift.rezeroed()
         return bias
 
+    @property
+    def last_raw(self) -> Sequence[float] | None:
+        """The last wrench received (sensor frame, as sent), None before the first."""
+        return self._last_raw
+
+    def start_zeroing(self) -> None:
+        """Zeroes the sensor again over a steady window from the next wrench, as at start-up, and measures
+        the noise floor again (`tare_window` 0: on the next wrench alone). The laws hold still until it is
+        done (`zeroing`); the bias in use stays until then."""
+        self._zeroing = self._new_zeroing()
+        self._tare_pending = True
+
+    def cancel_zeroing(self) -> str:
+        """Gives up a zeroing that has not finished: the bias stays as it was. Returns why it was waiting."""
+        note = self._zeroing.note if self._zeroing is not None else "no valid wrench"
+        self._tare_pending = False
+        return note
+
+    def _new_zeroing(self) -> SteadyZero | None:
+        s = self.settings
+        if s.tare_window <= 0.0:
+            return None
+        return SteadyZero(s.tare_window, s.tare_max_force_spread, s.tare_max_torque_spread,
+                          int(s.tare_min_samples), s.tare_spread_sigmas)
+
     def reset_safety(self) -> bool:
         """Clears a latched global-limit trip; returns whether it was latched."""
         was = self._latched
@@ -546,11 +574,20 @@ class ContactControl:
                 )
                 self._measured_floor(zeroing)
             self._tare_pending = False
+            if self._drift is not None and self._drift.drift is not None:  # measured: it is zero again
+                self._drift.rezeroed()
         code, w = self.preprocessor.process(wrench, T_control_sensor, R_world_sensor)
         if code != SAFETY_OK:
             if code == SAFETY_NAN:
                 return self._hold(t, SAFETY_NAN, "wrench contains NaN or inf: holding until valid data")
+            self._over_global += 1
+            if self._over_global < self._limit_samples and not self._latched:
+                # A spike unless the next wrench is over too (force_limit_samples): a 15 N push on a 3.6 N
+                # current estimate crossed 25 N on single samples. The last command stands meanwhile.
+                return self._result(t, SAFETY_OK, "")
             self._trip(w)
+        else:
+            self._over_global = 0
         assert w is not None  # None only with SAFETY_NAN, returned above
         if self._latched:
             return self._hold(t, SAFETY_OVER_LIMIT, self._latch_message)
@@ -598,7 +635,7 @@ class ContactControl:
         watch = self._watch
         if watch is not None:
             for i in self._active:
-                if watch.add(i, t, v[i], tuning[i].min_velocity):
+                if watch.add(i, t, v[i], self._watch_floor[i]):
                     stopped = self._oscillating(t, i)
                     if stopped is not None:
                         return stopped
@@ -620,6 +657,10 @@ class ContactControl:
         cutoff = self.preprocessor.cutoff if s.lp_filter_enabled else None
         floor = NoiseFloor.measure(zeroing.std(), rate, n, cutoff, zeroing.lag1())
         self._floor_noise = floor
+        self._watch_floor_update()
+        if self._drift is not None:  # steady at rest now means within this noise
+            self._drift.noise = floor.std
+            self._drift.restart()
         note = floor.describe()
         k = s.noise_deadband_sigmas
         if k > 0.0:
@@ -748,6 +789,20 @@ class ContactControl:
         self.notes.append(f"re-tared at rest: the zero had moved by {moved:.3g} N (auto_tare_drift "
                           f"{limit:g} N)")
 
+    def _watch_floor_update(self) -> None:
+        """The watchdog's velocity floor per axis: the minimum velocity, or the swing the sensor's noise
+        alone gives a law (WATCH_NOISE_SIGMAS filtered stds / b) when larger: held against a push, a law's
+        force error crosses zero with the noise and a 3.6 N estimate reversed a spring's velocity 6 times in
+        2 s with nothing oscillating."""
+        floor = self._floor_noise
+        self._watch_floor = [t.min_velocity for t in self._tuning]
+        if floor is None:
+            return
+        for i, law in enumerate(self._laws):
+            if law.law != LAW_NONE and law.damping > 0.0:
+                noise = floor.force if i < 3 else floor.torque
+                self._watch_floor[i] = max(self._watch_floor[i], WATCH_NOISE_SIGMAS * noise / law.damping)
+
     def _oscillating(self, t: float, axis: int) -> CycleResult | None:
         """The watchdog saw `axis` oscillate: its gain is halved the first time (the move goes on), the move
         ends (OSCILLATION, every axis holds) the second."""
@@ -764,6 +819,7 @@ class ContactControl:
         laws[axis] = lower
         self._laws = laws
         self._halved[axis] = True
+        self._watch_floor_update()
         k = f", k {law.stiffness:g} -> {lower.stiffness:g}" if law.law == LAW_SPRING else ""
         self.notes.append(f"{what}: gain halved (b {law.damping:g} -> {lower.damping:g}{k})")
         return None

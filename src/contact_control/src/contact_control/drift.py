@@ -16,16 +16,20 @@ __all__ = ["ZeroDrift"]
 class ZeroDrift:
     """Windows of steady bias estimates at rest and the drift they show."""
 
-    def __init__(self, window: float, max_force_spread: float, max_torque_spread: float) -> None:
+    def __init__(self, window: float, max_force_spread: float, max_torque_spread: float,
+                 spread_sigmas: float = 0.0) -> None:
         self.window = window
         self._spreads = (max_force_spread, max_torque_spread)
+        self._sigmas = spread_sigmas
+        #: The sensor's noise std per axis (the noise floor): steady means within `spread_sigmas` of it.
+        self.noise: tuple[float, ...] | None = None
         self._steady = SteadyZero(window, max_force_spread, max_torque_spread)
         #: The last drift measured [N, Nm] per sensor axis (None before the first steady window).
         self.drift: tuple[float, ...] | None = None
 
     def restart(self) -> None:
         """Not at rest any more (a law or an exceeded action runs): the window starts again."""
-        self._steady = SteadyZero(self.window, *self._spreads)
+        self._steady = SteadyZero(self.window, *self._spreads, spread_sigmas=self._sigmas, noise=self.noise)
 
     def add(self, estimate: Sequence[float], bias: Sequence[float], t: float) -> tuple[float, ...] | None:
         """One bias estimate at rest; the drift when a steady window completes (then a new one starts)."""

@@ -120,6 +120,10 @@ class ContactControlSettings:
         "(a touch or a jolt); above the sensor's noise"
     )
     tare_max_torque_spread: float = _pos(0.4, "Nm", "same for torques")
+    tare_spread_sigmas: float = _nonneg(
+        8.0, "noise stds", "the spread limits grow to this many noise stds for a noisy sensor (the std of "
+        "the window's first `tare_min_samples`, median-based; a current estimate has 3.6 N); 0: fixed limits"
+    )
     bias: tuple[float, ...] = param(
         (0.0,) * 6, type="floats", length=6, unit="N, Nm",
         doc="known sensor offset (sensor frame) subtracted until the first tare",
@@ -137,8 +141,8 @@ class ContactControlSettings:
         "refused (the sensor cannot tell it from its noise); 0: not checked"
     )
     force_limit_samples: float = param(
-        2.0, ge=1.0, doc="a force/torque limit ends a move once exceeded on this many wrenches in a row (one "
-        "spike does not; 1: the first, as the fork)"
+        2.0, ge=1.0, doc="a force/torque limit ends a move, and a global limit latches, once exceeded on "
+        "this many wrenches in a row (one spike does not; 1: the first, as the fork)"
     )
     command_latency: float = _nonneg(
         0.01, "s", "the command path's latency: the jogger's period, the driver, the arm's servo (the laws' "

@@ -27,7 +27,6 @@ from contact_control.controller import CycleResult
 from contact_control.frames import transform
 from contact_control.params import ContactControlSettings, ParamError, load_settings
 from contact_control.payload_service import PayloadServices
-from contact_control.preprocess import PreprocessError
 from contact_control.request import CODE_NAMES
 from contact_control.stage import ContactStage, Velocity
 
@@ -37,6 +36,9 @@ __all__ = ["ContactControlRos", "TfPoses", "fill_status_words", "read_settings"]
 #: also hand it to jog_arm.
 Emit = Callable[[Velocity, float], None]
 
+
+#: [s] a ~tare waits this long beyond its window for a steady one before it gives up.
+TARE_TIMEOUT = 5.0
 
 _TF_ERRORS = (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException)
 
@@ -215,12 +217,24 @@ class ContactControlRos:
                 self._ended.wait(0.1)
 
     def _on_tare(self, _req: Any) -> TriggerResponse:
+        """Zeroes over a steady window as at start-up (the laws hold still meanwhile) and answers with the
+        bias and the noise floor; gives up, keeping the old bias, after `TARE_TIMEOUT` s more than the
+        window without a steady one (the reason in the answer)."""
         with self._lock:
-            try:
-                bias = self._stage.ctrl.tare()
-            except PreprocessError as err:
-                return TriggerResponse(success=False, message=str(err))
-        return TriggerResponse(success=True, message="bias [N, Nm]: " + ", ".join(f"{b:.4g}" for b in bias))
+            ctrl = self._stage.ctrl
+            if ctrl.last_raw is None:
+                return TriggerResponse(success=False, message="no wrench received yet: the bias is unchanged")
+            ctrl.start_zeroing()
+            deadline = rospy.get_time() + self._s.tare_window + TARE_TIMEOUT
+            while ctrl.zeroing:
+                if rospy.is_shutdown() or rospy.get_time() > deadline:
+                    why = ctrl.cancel_zeroing()
+                    return TriggerResponse(success=False, message=f"not zeroed, the bias is unchanged: {why}")
+                self._ended.wait(0.02)  # releases the lock for the wrenches being averaged
+            bias = ctrl.preprocessor.bias
+            floor = ctrl.noise_floor
+        message = "bias [N, Nm]: " + ", ".join(f"{b:.4g}" for b in bias)
+        return TriggerResponse(success=True, message=message + ("; " + floor.describe() if floor else ""))
 
     def _on_stop(self, _req: Any) -> TriggerResponse:
         with self._lock:

@@ -246,8 +246,8 @@ class ContactStage:
             message += "; gains lowered for the sensor's rate: " + ", ".join(limited)
         if self.ctrl.zeroing:
             message += (
-                "; the sensor is still being zeroed (tare_on_startup): the laws act once ~status shows "
-                "safety ok; keep the tool free until then, a touch now would be taken as the zero"
+                "; the sensor is still being zeroed (at start-up or by ~tare): the laws act once ~status "
+                "shows safety ok; keep the tool free until then, a touch now would be taken as the zero"
             )
         return Answer(True, SUCCESS, message, move_id)
 

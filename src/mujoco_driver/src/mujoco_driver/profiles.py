@@ -30,7 +30,7 @@ import yaml
 from mujoco_driver.controllers import ControllerError, ControllerSpec
 
 __all__ = ["DriverProfile", "FrameLink", "ProfileError", "ReflexSpec", "WrenchSpec", "known_profiles",
-           "load_profile", "option_params", "profile_path"]
+           "load_profile", "option_params", "profile_path", "variant_options"]
 
 PROFILE_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
                            "config", "profiles")
@@ -248,6 +248,18 @@ def option_params(name_or_path: str) -> dict[str, str]:
             raise ProfileError(f"{where}.{option}: must be an option ({sorted(options)}) mapped to a "
                                "parameter name")
     return dict(entries)
+
+
+def variant_options(name_or_path: str) -> list[dict[str, Any]]:
+    """The options of each variant the profile offers, one option at a time (the others at their defaults),
+    e.g. [{"series": "cb3"}, {"series": "e_series"}, ...]; [{}] for a profile without variants.
+
+    Raises:
+        ProfileError: If there is no such profile file or it is not valid YAML.
+    """
+    raw = _read(profile_path(name_or_path))
+    out = [{option: value} for option, choices in (raw.get("variants") or {}).items() for value in choices]
+    return out or [{}]
 
 
 def load_profile(name_or_path: str, options: Mapping[str, Any] | None = None) -> DriverProfile:

@@ -53,6 +53,7 @@ from robot_setup.analysis import (
 )
 from robot_setup.collisions import CollisionChecker
 from robot_setup.driver import DriverError, DriverInterface, driver_interface
+from robot_setup.sensor_limits import contact_force_for
 
 __all__ = ["GeneratorError", "Plan", "RobotSpec", "command_line", "main", "plan_robot", "recorded_command",
            "render", "write_package"]
@@ -242,6 +243,9 @@ def plan_robot(spec: RobotSpec, log=print) -> Plan:
         f"{'-' if geometry.hybrid_direction < 0 else '+'}X, obstacle {gap * 100:.1f} cm below the tip, "
         f"compliant move at most {geometry.compliant_max_travel:.2f} m"
     )
+    if spec.driver:  # written into demos.yaml by the templates
+        force = contact_force_for(spec.driver, geometry.contact_force_limit)
+        log(f"[robot] demos' contact force with {spec.driver}: {force.limit:g} N ({force.comment()})")
     motions = demo_motions(geometry, approach=gap)
     heights = [h for h in (reach * f for f in (0.2, 0.28, 0.36, 0.45)) if h >= gap + 0.04]
     bounded = np.isfinite(arm.lower) & np.isfinite(arm.upper)

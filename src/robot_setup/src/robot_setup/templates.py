@@ -14,6 +14,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from robot_setup.driver import GENERIC_TRAJECTORY_TOPIC, DriverInterface
+from robot_setup.sensor_limits import contact_force_for
 
 if TYPE_CHECKING:
     import numpy as np
@@ -178,6 +179,14 @@ hybrid:                   # X compliant move with a Z spring
   direction: {g.hybrid_direction}           # {direction}
   speed: {_num(g.hybrid_speed)}             # [m/s]
   travel: {_num(g.hybrid_travel)}             # [m] max path deviation, where the move ends
+"""
+    if not d.generic:
+        force = contact_force_for(d.profile, g.contact_force_limit)
+        files["config/demos.yaml"] += f"""
+contact_force:            # the compliant move's and the hybrid's force limit: the stop on contact
+  limit: {_num(g.contact_force_limit)}              # [N] the thesis's, with the simulated wrist sensor
+  drivers:                # make demo DRIVER=<profile>: derived by make robot from the profile's wrench noise
+    {d.profile}: {_num(force.limit)}  # [N] {force.comment()}
 """
     files["config/named_poses.yaml"] = f"""# Named joint configurations of the {name} [rad] for named_poses' ~move_to; {generated}.
 # `start` is sim.yaml's start_pose; `home` is it with the tool tip lifted.

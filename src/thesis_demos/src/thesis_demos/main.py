@@ -3,13 +3,28 @@
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 import time
 from collections.abc import Sequence
 from typing import Any
 
-__all__ = ["main"]
+from contact_control.noise_floor import NoiseFloor
+from contact_control.params import ContactControlSettings
+
+from thesis_demos.scenarios import SURFACE_TOLERANCE
+
+__all__ = ["main", "unresolvable"]
+
+#: run_demos' exit status when nothing failed but some demonstrations cannot be done ([CANNOT]).
+EXIT_CANNOT = 3
+
+#: Raw noise stds on top of a push that must stay under the global limit (latched on 2 wrenches in a row).
+PUSH_NOISE_SIGMAS = 3.0
+
+#: The force tracking's input wanders this many filtered noise stds either way (95 % of the time).
+TRACKING_NOISE_SIGMAS = 2.0
 
 
 def _args(argv: Sequence[str]) -> argparse.Namespace:
@@ -32,22 +47,41 @@ def _args(argv: Sequence[str]) -> argparse.Namespace:
     return parser.parse_args(argv)
 
 
-def unresolvable(scenario: Any, resolvable: tuple[float, float] | None) -> str:
-    """Why the sensor cannot do `scenario` ("" if it can): a force or torque limit below what it resolves."""
-    if resolvable is None:
+def unresolvable(scenario: Any, floor: NoiseFloor | None, sigmas: float,
+                 global_force: float = ContactControlSettings.global_max_force) -> str:
+    """Why the sensor cannot do `scenario` ("" if it can), from contact_control's noise floor, its
+    noise_limit_sigmas and global_max_force: a force or torque limit, or a push, below what it resolves; a
+    push whose raw noise (PUSH_NOISE_SIGMAS stds) reaches the global limit; or force tracking whose tolerance
+    the noise the laws act on (+- TRACKING_NOISE_SIGMAS filtered stds) exceeds."""
+    if floor is None or sigmas <= 0.0:
         return ""
-    force, torque = resolvable
+    force, torque = floor.resolvable(sigmas)
+    resolves = (f"the sensor resolves forces of {force:.2g} N and more (contact_control's noise floor times "
+                "its noise_limit_sigmas)")
     laws = list(scenario.laws.values())
     if scenario.follow_up:
         laws += list(scenario.follow_up.laws.values())
     for law in laws:
         if 0.0 < law.force_limit < force:
-            return (f"the sensor resolves forces of {force:.2g} N and more (contact_control's noise floor "
-                    f"times its noise_limit_sigmas); this demonstration stops at {law.force_limit:g} N: "
-                    "raise demos.yaml's contact_force (drivers: {<profile>: N})")
+            return (f"{resolves}; this demonstration stops at {law.force_limit:g} N: raise demos.yaml's "
+                    "contact_force (drivers: {<profile>: N})")
         if 0.0 < law.torque_limit < torque:
             return (f"the sensor resolves torques of {torque:.2g} Nm and more; this demonstration stops at "
                     f"{law.torque_limit:g} Nm")
+    raw = PUSH_NOISE_SIGMAS * max(floor.std[:3])
+    for push in scenario.pushes:
+        magnitude = math.hypot(*push.force)
+        if 0.0 < magnitude < force:
+            return f"{resolves}; this demonstration pushes with {magnitude:g} N, within its noise"
+        if magnitude + raw > global_force:
+            return (f"its {magnitude:g} N push plus the sensor's noise ({PUSH_NOISE_SIGMAS:g} stds: "
+                    f"{raw:.2g} N) reaches contact_control's {global_force:g} N global limit "
+                    "(global_max_force), which would latch during the push")
+    wander = TRACKING_NOISE_SIGMAS * floor.force
+    if scenario.uses_laws_service and wander > SURFACE_TOLERANCE:  # force tracking
+        return (f"the force the laws track wanders +-{wander:.2g} N on the sensor's noise alone "
+                f"({TRACKING_NOISE_SIGMAS:g} filtered stds), beyond this demonstration's "
+                f"+-{SURFACE_TOLERANCE:g} N")
     return ""
 
 
@@ -82,11 +116,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         for name, reason in cannot.items():
             if any(s.name == name for s in scenarios):
                 print(f"[CANNOT] {name}: this arm cannot do it as configured: {reason}", flush=True)
-    resolvable = runner.resolvable()
+    floor = runner.noise_floor()
+    sigmas = runner.noise_limit_sigmas()
+    global_force = runner.global_max_force()
     for scenario in scenarios:
         if scenario.name in cannot:
             continue
-        reason = unresolvable(scenario, resolvable)
+        reason = unresolvable(scenario, floor, sigmas, global_force)
         if reason:  # the sensor cannot tell this demonstration's force limit from its noise
             cannot[scenario.name] = reason
             print(f"[CANNOT] {scenario.name}: {reason}", flush=True)
@@ -107,5 +143,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     with open(report, "w") as out:
         out.write(markdown(args.robot or "robot", results, time.monotonic() - started))
     print(f"report: {report}", flush=True)
-    refused = any(s.name in cannot for s in scenarios)
-    return 0 if all(v.passed for _, v, _ in results) and not refused else 1
+    if not all(v.passed for _, v, _ in results):
+        return 1
+    return EXIT_CANNOT if any(s.name in cannot for s in scenarios) else 0

@@ -327,12 +327,19 @@ class DemoRunner:
         if not response.success:
             raise RuntimeError(f"{scenario.name}: contact_control refused the request (see its ~status)")
 
-    def resolvable(self, timeout: float = 10.0) -> tuple[float, float] | None:
-        """The smallest force [N] and torque [Nm] limits contact_control accepts (its noise floor, measured
-        while zeroing, times its noise_limit_sigmas); None when it reports no noise floor (not zeroed, or an
-        older node)."""
-        sigmas = float(rospy.get_param(f"{self.names.contact_control}/noise_limit_sigmas",
-                                        ContactControlSettings.noise_limit_sigmas))
+    def noise_limit_sigmas(self) -> float:
+        """contact_control's noise_limit_sigmas (its default if unset)."""
+        return float(rospy.get_param(f"{self.names.contact_control}/noise_limit_sigmas",
+                                     ContactControlSettings.noise_limit_sigmas))
+
+    def global_max_force(self) -> float:
+        """contact_control's global_max_force [N] (its default if unset)."""
+        return float(rospy.get_param(f"{self.names.contact_control}/global_max_force",
+                                     ContactControlSettings.global_max_force))
+
+    def noise_floor(self, timeout: float = 10.0) -> NoiseFloor | None:
+        """contact_control's noise floor as its ~status reports it (measured while zeroing); None when it
+        reports none (not zeroed, or an older node)."""
 
         def reported() -> bool:  # a noise floor, or zeroed without one
             with self._status_lock:
@@ -348,8 +355,7 @@ class DemoRunner:
             status = self._last_status
         if status is None or len(status.noise_filtered) != 6:
             return None
-        floor = NoiseFloor(tuple(status.noise_std), 0.0, 0, tuple(status.noise_filtered))
-        return floor.resolvable(sigmas)
+        return NoiseFloor(tuple(status.noise_std), 0.0, 0, tuple(status.noise_filtered))
 
     def _force(self, axis: str) -> float | None:
         """The controller's latest force [N] along `axis` (x, y or z; control frame), None before a status."""
