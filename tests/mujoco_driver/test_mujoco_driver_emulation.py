@@ -39,8 +39,12 @@ def test_franka_profile_resolves_arm_id_and_rate_options():
     assert p.wrench.topic == "franka_state_controller/F_ext"
     assert [t.child for t in p.tf] == ["panda_NE", "panda_EE", "panda_K"]
     assert p.reflex.force_thresholds == (20.0, 20.0, 20.0, 25.0, 25.0, 25.0)
-    other = load_profile("franka_ros", {"arm_id": "fr3", "publish_rate": 100.0})
+    other = load_profile("franka_ros", {"arm_id": "fr3", "publish_rate": 100.0,
+                                        "reflex_force_thresholds": [30.0] * 6})
     assert other.publish_rate == 100.0 and other.wrench.frame == "fr3_K" and other.tf[0].parent == "fr3_link8"
+    assert other.reflex.force_thresholds == (30.0,) * 6  # a whole-value placeholder keeps the list
+    with pytest.raises(ProfileError, match=r"reflex\.force_thresholds"):
+        load_profile("franka_ros", {"reflex_force_thresholds": [30.0] * 5})
 
 
 def test_known_profiles_are_the_files_in_config_profiles():
@@ -294,7 +298,10 @@ def test_the_profiles_sensor_error_keys_are_checked():
 
 
 def test_options_the_real_driver_reads_from_parameters_are_named_by_the_profile():
-    assert option_params("franka_ros") == {"publish_rate": "franka_state_controller/publish_rate"}
+    assert option_params("franka_ros") == {
+        "publish_rate": "franka_state_controller/publish_rate",
+        "reflex_force_thresholds": "franka_control/collision_config/upper_force_thresholds_nominal",
+    }
     assert option_params("ur_robot_driver") == {}
     base = yaml.safe_load(open(os.path.join(os.path.dirname(__file__), "..", "..", "src", "mujoco_driver",
                                             "config", "profiles", "franka_ros.yaml")))

@@ -9,6 +9,7 @@ import pathlib
 
 import numpy as np
 import pytest
+import yaml
 
 pytest.importorskip("controller_manager_msgs.srv", reason="needs devel/setup.bash (make test sources it)")
 
@@ -57,3 +58,8 @@ def test_the_panda_bring_up_rate_reaches_the_driver_and_the_noise_floor_refuses_
     finally:
         wrench.close()
         status.close()
+        # The driver configuration was loaded at the root of this session's master and would outlive the
+        # launch: later tests' emulated franka would read 100 Hz (or 30 N reflexes) from it.
+        for key in yaml.safe_load(FRANKA_CONFIG.read_text()):
+            if rospy.has_param(f"/{key}"):
+                rospy.delete_param(f"/{key}")

@@ -10,7 +10,8 @@ profiles' YAML):
 * an option named like a top-level key sets that key (``publish_rate``);
 * ``variants: {option: {value: {key: value, ...}}}``: an option's value selects overrides
   (``series: e_series`` -> ``publish_rate: 500``; a mapping such as ``wrench`` is merged key by key);
-* every string may use ``{option}`` placeholders (``"{arm_id}_K"``);
+* every string may use ``{option}`` placeholders (``"{arm_id}_K"``); a value that is one placeholder alone
+  takes the option's value as it is (``force_thresholds: "{reflex_force_thresholds}"``: a list);
 * ``option_params: {option: parameter}``: the parameter the real driver reads that option from (a state
   controller's ``publish_rate``); the node takes it from the parameter server when the user's
   options do not set it, so a robot package's driver configuration reaches the emulation as it reaches the
@@ -176,6 +177,8 @@ def profile_path(name_or_path: str) -> str:
 
 
 def _format(value: Any, options: Mapping[str, Any], where: str) -> Any:
+    if isinstance(value, str) and value.startswith("{") and value.endswith("}") and value[1:-1] in options:
+        return options[value[1:-1]]  # a whole-value placeholder keeps the option's type (a list, a number)
     if isinstance(value, str):
         try:
             return value.format_map(options)
