@@ -39,7 +39,7 @@ class Cell:
         jog_params = {**_yaml(SRC / "jog_arm/config/jog_arm.yaml"), **_yaml(pkg / "config/jog_arm.yaml")}
         jog, _ = JogSettings.from_params_with_warnings(jog_params, "/jog_arm_server/")
         urdf = subprocess.run(
-            [sys.executable, str(SRC / "mujoco_driver/scripts/make_description"),
+            [sys.executable, str(SRC / "control_stack/scripts/make_description"),
              f"@{pkg / 'config/description.args'}"],
             check=True, capture_output=True, text=True,
         ).stdout

@@ -336,19 +336,19 @@ def test_publish_on_command_answers_every_twist_without_waiting_for_the_timer(ro
 
 
 def test_contact_controls_twists_pass_the_guard_and_others_do_not(ros_node) -> None:
-    """Two-node layout: contact_control's twists reach jog_arm on the same topic as a keyboard's. At 25 N
-    (over the 20 N guard limit) a keyboard twist into the contact becomes a retreat, but the exempt node's
-    (by its caller id) passes: its laws react to the force themselves (a compliant move's move_away, a
-    force-tracking press). Before, the guard slowed contact_control's own moves from 2 N on."""
-    import subprocess
-
+    """Two-node layout: contact_control's twists reach jog_arm on an input of their own
+    (contact_cmd_in_topic). At 25 N (over the 20 N guard limit) a twist into the contact on cmd_in_topic (a
+    keyboard's) becomes a retreat, the same twist on contact_cmd_in_topic passes: contact_control's laws react
+    to the force themselves (a compliant move's move_away, a force-tracking press). Both come from this one
+    node: nothing depends on who sends."""
     from geometry_msgs.msg import WrenchStamped
     from std_msgs.msg import Float64MultiArray
 
     rospy = ros_node
     params = {
         "command_out_type": "velocity_array", "integrate_from": "measured",
-        "contact_guard_wrench_topic": "/jog_guard/contact", "contact_guard_exempt": [rospy.get_name()],
+        "contact_guard_wrench_topic": "/jog_guard/contact",
+        "contact_cmd_in_topic": "/jog_guard/contact_twist",
     }
     contact = rospy.Publisher("/jog_guard/contact", WrenchStamped, queue_size=1)
     press = WrenchStamped()
@@ -356,6 +356,7 @@ def test_contact_controls_twists_pass_the_guard_and_others_do_not(ros_node) -> N
     press.wrench.force.z = 25.0  # the surface pushes the tool up
     pressing = Repeater(contact).start(press, rate=100.0)
     model = ArmModel(UR5.urdf, UR5.tip)
+    laws = Sender(rospy, "/jog_guard/contact_twist")
 
     def vz() -> float:
         return float(eef_velocity(model, UR5.start, commands.last().data)[2])
@@ -366,22 +367,18 @@ def test_contact_controls_twists_pass_the_guard_and_others_do_not(ros_node) -> N
             sender,
         ):
             commands.wait_connected()
-            # Exempt (this node): down into the contact as asked.
-            sender.start(twist_msg((0.0, 0.0, -0.02, 0.0, 0.0, 0.0)), rate=50.0)
+            wait_until(lambda: laws.pub.get_num_connections() > 0, 20, "jog_arm on contact_cmd_in_topic")
+            # contact_control's input: down into the contact as asked.
+            laws.start(twist_msg((0.0, 0.0, -0.02, 0.0, 0.0, 0.0)), rate=50.0)
             commands.wait_for(10, timeout=5)
-            wait_until(lambda: vz() < -0.015, 5, "the exempt twist to move down")
+            wait_until(lambda: vz() < -0.015, 5, "the contact_cmd_in_topic twist to move down")
+            laws.stop()
+            # The outside input: the same twist is guarded into a retreat.
+            sender.start(twist_msg((0.0, 0.0, -0.02, 0.0, 0.0, 0.0)), rate=50.0)
+            wait_until(lambda: 0.0 < vz() <= 0.0051, 10, "the guarded twist to back off at 5 mm/s")
             sender.stop()
-            # Another node (rostopic pub): the same twist is guarded into a retreat.
-            keyboard = subprocess.Popen(
-                ["rostopic", "pub", "-r", "50", "/jog_guard/twist", "geometry_msgs/TwistStamped",
-                 "{twist: {linear: {z: -0.02}}}", "__name:=keyboard"],
-                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
-            )
-            try:
-                wait_until(lambda: 0.0 < vz() <= 0.0051, 10, "the guarded twist to back off at 5 mm/s")
-            finally:
-                keyboard.terminate()
-                keyboard.wait(10)
     finally:
+        laws.stop()
+        laws.pub.unregister()
         pressing.stop()
         contact.unregister()

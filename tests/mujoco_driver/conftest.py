@@ -3,31 +3,17 @@
 from __future__ import annotations
 
 import pathlib
-import subprocess
-import sys
 from dataclasses import dataclass
 
 import pinocchio as pin
 import pytest
+from harness.description import make_description
 from mujoco_driver.sim import Simulation
 
 from mujoco_driver.config import SceneConfig, load_scene_config
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-SCRIPT = ROOT / "src" / "mujoco_driver" / "scripts" / "make_description"
 ROBOTS = ("ur5_custom", "panda_custom")
-
-
-def make_description(*args: str, python: str | None = sys.executable) -> subprocess.CompletedProcess:
-    """Run the make_description executable (with ``python``, or through its shebang when None)."""
-    cmd = ([python] if python else []) + [str(SCRIPT), *args]
-    return subprocess.run(cmd, capture_output=True, text=True, timeout=60, check=False)
-
-
-@pytest.fixture(scope="session")
-def run_make_description():
-    """The make_description runner (a fixture, so test modules need not import this conftest)."""
-    return make_description
 
 
 @dataclass

@@ -15,7 +15,7 @@ import xml.etree.ElementTree as ET
 import mujoco
 import numpy as np
 import pytest
-from mujoco_driver.description import ToolSpec, build_description, find_example_robot_data, read_source
+from control_stack.description import ToolSpec, build_description, find_example_robot_data, read_source
 from mujoco_driver.meshes import LinkGeometry, prepare_collision
 from mujoco_driver.scene import build_scene, mujoco_urdf_report
 from mujoco_driver.sim import Simulation

@@ -86,7 +86,7 @@ class Driver:
 
 @pytest.fixture(scope="module")
 def driver(ros_node):
-    script = ROOT / "src/mujoco_driver/scripts/make_description"
+    script = ROOT / "src/control_stack/scripts/make_description"
     urdf = subprocess.run(
         [sys.executable, str(script), f"@{CONFIG / 'description.args'}"],
         capture_output=True, text=True, check=True, timeout=60,

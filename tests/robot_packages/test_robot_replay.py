@@ -64,7 +64,7 @@ def test_a_recording_replays_through_hardware_launch_with_a_law_set_before_playb
             h.wait_for_service("/configure_cartesian_impedance", timeout=40)
             h.wait_for_topic("/jog_arm_server/status", timeout=40)
             status = Collector("/contact_control_node/status", ContactControlStatus)
-            twists = Collector("/jog_arm_server/delta_jog_cmds", TwistStamped)
+            twists = Collector("/jog_arm_server/contact_cmds", TwistStamped)  # contact_control's
             commands = Collector("/joint_group_vel_controller/command", Float64MultiArray)
             try:
                 req = ConfigureForceControlRequest()

@@ -9,7 +9,7 @@ from typing import Any
 import pytest
 import yaml
 from contact_control.params import ContactControlSettings
-from mujoco_driver.description import ToolSpec
+from control_stack.description import ToolSpec
 from robot_setup.check import read_description_args, tool_payload_problems, tool_spec
 
 SRC = pathlib.Path(__file__).resolve().parents[2] / "src"

@@ -44,12 +44,12 @@ class JogArmNode:
         self._subs = [
             rospy.Subscriber(settings.joint_topic, JointState, self._on_joints, **fast),
             rospy.Subscriber(settings.cmd_in_topic, TwistStamped, self._on_twist, **fast),
+            # contact_control's laws (two-node layout): an input of their own, not through the guard.
+            rospy.Subscriber(settings.contact_cmd_in_topic, TwistStamped, self._on_contact_twist, **fast),
         ]
         if settings.contact_guard_enabled:  # the force from contact_control_node's ~contact_wrench
             self._subs.append(rospy.Subscriber(settings.contact_guard_wrench_topic, WrenchStamped,
                                                self._on_contact_wrench, **fast))
-        # Publishers whose twists pass unguarded, told apart by the caller id rospy keeps with each message.
-        self._exempt = frozenset(rospy.resolve_name(name) for name in settings.contact_guard_exempt)
         start_ticker(self._tick, settings.pub_period, "jog_arm_cycles")
 
     def _now(self) -> float:
@@ -70,10 +70,16 @@ class JogArmNode:
             self.stage.on_contact_wrench((f.x, f.y, f.z), msg.header.frame_id.lstrip("/"), self._now())
 
     def _on_twist(self, msg: TwistStamped) -> None:
+        """An outside twist (keyboard, GUI, rostopic pub): through the contact guard."""
+        self._twist(msg, guarded=True)
+
+    def _on_contact_twist(self, msg: TwistStamped) -> None:
+        """contact_control's twist: its laws react to the force themselves."""
+        self._twist(msg, guarded=False)
+
+    def _twist(self, msg: TwistStamped, guarded: bool) -> None:
         lin, ang = msg.twist.linear, msg.twist.angular
         self.ros.ensure_frame(msg.header.frame_id)
-        header = getattr(msg, "_connection_header", None) or {}
-        guarded = header.get("callerid") not in self._exempt
         with self._lock:
             cycle = self.stage.on_twist((lin.x, lin.y, lin.z, ang.x, ang.y, ang.z), msg.header.frame_id,
                                         self._now(), guarded=guarded)

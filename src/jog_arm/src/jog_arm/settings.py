@@ -39,6 +39,7 @@ _RENAMED = {
     "use_gazebo": "simu",
     "coll_check": None,
     "check_collisions": None,
+    "contact_guard_exempt": "contact_cmd_in_topic",  # ours before: told contact_control apart by caller id
 }
 
 # Keys read by the node only (not part of the motion law), accepted without warning.
@@ -101,6 +102,11 @@ class JogSettings:
     )
     joint_topic: str = _topic("joint_states", "sensor_msgs/JointState input")
     cmd_in_topic: str = _topic("jog_arm_server/delta_jog_cmds", "geometry_msgs/TwistStamped input")
+    contact_cmd_in_topic: str = _topic(
+        "jog_arm_server/contact_cmds", "geometry_msgs/TwistStamped input of contact_control's laws (two-node "
+        "layout; contact_control's `velocity_out_topic`): not through the contact guard, its laws react to "
+        "the force themselves"
+    )
     cmd_frame: str = param(
         "", doc="frame of commands with an empty `header.frame_id`; `\"\"` = `planning_frame`"
     )
@@ -203,11 +209,6 @@ class JogSettings:
     )
     contact_guard_wrench_topic: str = param(
         "contact_control_node/contact_wrench", doc="two-node layout: where the contact force comes from"
-    )
-    contact_guard_exempt: tuple[str, ...] = param(
-        ("contact_control_node",), type="strings",
-        doc="two-node layout: nodes whose twists on `cmd_in_topic` pass unguarded (contact_control: its laws "
-        "react to the force themselves); relative names resolve in jog_arm's namespace",
     )
 
     @classmethod

@@ -27,9 +27,7 @@ from typing import Any
 import numpy as np
 import yaml
 from contact_control.params import ContactControlSettings
-from jog_arm.kinematics import ArmModel, KinematicsError
-from jog_arm.settings import JogSettings
-from mujoco_driver.description import (
+from control_stack.description import (
     DescriptionError,
     ToolSpec,
     _parser,
@@ -37,6 +35,8 @@ from mujoco_driver.description import (
     find_example_robot_data,
     read_source,
 )
+from jog_arm.kinematics import ArmModel, KinematicsError
+from jog_arm.settings import JogSettings
 from thesis_demos.geometry import (
     DemoConfigError,
     demo_motions,

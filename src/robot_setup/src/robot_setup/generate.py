@@ -31,8 +31,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from jog_arm.kinematics import ArmModel
-from mujoco_driver.description import (
+from control_stack.description import (
     ERD_PACKAGE,
     DescriptionError,
     ToolSpec,
@@ -40,6 +39,7 @@ from mujoco_driver.description import (
     find_example_robot_data,
     read_source,
 )
+from jog_arm.kinematics import ArmModel
 from thesis_demos.geometry import SURFACE_TRAVEL, DemoGeometry, demo_motions
 
 from robot_setup.analysis import (

@@ -72,6 +72,7 @@ def render(plan: Plan, analysis: list[str]) -> dict[str, str]:
 
   <buildtool_depend>catkin</buildtool_depend>
   <exec_depend>contact_control</exec_depend>
+  <exec_depend>control_stack</exec_depend>
   <exec_depend>jog_arm</exec_depend>
   <exec_depend>keyboard_publisher</exec_depend>
   <exec_depend>mujoco_driver</exec_depend>
@@ -93,7 +94,7 @@ install(DIRECTORY config launch DESTINATION ${{CATKIN_PACKAGE_SHARE_DESTINATION}
         for link in plan.removed
     )
     com = (0.0, 0.0, 0.05)
-    files["config/description.args"] = f"""# Arguments of mujoco_driver's make_description for the {name} (read with: make_description @description.args);
+    files["config/description.args"] = f"""# Arguments of control_stack's make_description for the {name} (read with: make_description @description.args);
 # {generated}.
 --source {plan.source}
 {removed}# Wrist F/T sensor frame on the flange ({plan.spec.tip}), same axes as the flange.
@@ -207,7 +208,7 @@ tare_on_startup: true
 # config/contact_control.yaml; {generated}. Units: m, kg, s, N.
 
 ft_in_topic: wrench                                 # the MuJoCo driver's WrenchStamped (frame ft_sensor)
-velocity_out_topic: jog_arm_server/delta_jog_cmds   # into jog_arm
+velocity_out_topic: jog_arm_server/contact_cmds   # into jog_arm
 move_group: manipulator                             # informational
 
 fixed_frame: {plan.base}
@@ -228,7 +229,7 @@ wrench_timeout: 0.25                # [s]
 # `wrench` (written by make robot for a generic driver; run unchanged against mujoco_driver's emulated_robot.launch without a profile; adapt to your drivers). Loaded on top of contact_control's defaults.
 
 ft_in_topic: wrench
-velocity_out_topic: jog_arm_server/delta_jog_cmds
+velocity_out_topic: jog_arm_server/contact_cmds
 move_group: manipulator
 fixed_frame: {plan.base}
 velocity_command_frame: {plan.base}
@@ -484,7 +485,7 @@ def _contact_control_hardware(plan: Plan, command: str) -> str:
     )
     return f"""{header}
 ft_in_topic: {d.wrench_topic}                 # the driver's geometry_msgs/WrenchStamped, {d.rate:g} Hz
-velocity_out_topic: jog_arm_server/delta_jog_cmds
+velocity_out_topic: jog_arm_server/contact_cmds
 move_group: manipulator
 fixed_frame: {plan.base}
 velocity_command_frame: {plan.base}
@@ -567,7 +568,8 @@ def _hardware_launch(plan: Plan, command: str) -> str:
            f"{d.jog_topic} ({_MESSAGE[d.jog_command]}, jog_arm's output), {d.trajectory_topic} "
            "(trajectory_msgs/JointTrajectory, named_poses' output)."),
         f"This file loads robot_description ({name} + sensor frame + tool, whose tool_tip jog_arm moves), starts "
-        "robot_state_publisher for it, then jog_arm_server, contact_control_node and named_poses. If the driver's "
+        "robot_state_publisher for it, then contact_control and jog_arm in one process (control_stack_node, as "
+        "sim.launch; single_process:=false: two nodes) and named_poses. If the driver's "
         "launch runs its own robot_state_publisher on the stock URDF, give it this description instead and pass "
         "with_state_publisher:=false, or the arm's links get two tf publishers.",
     ))
@@ -596,10 +598,11 @@ def _launch_file(
   <arg name="with_state_publisher" default="true" doc="{state_publisher_doc}"/>
   <arg name="with_jog_arm" default="true" doc="start jog_arm_server"/>
   <arg name="with_contact_control" default="true" doc="start contact_control_node"/>
+  <arg name="single_process" default="true" doc="contact_control and jog_arm in one process (control_stack_node), as sim.launch; false: two nodes, the twist over a topic"/>
   <arg name="with_named_poses" default="true" doc="start named_poses (move_to a pose of config/named_poses.yaml)"/>
   <arg name="output" default="screen" doc="screen or log"/>
 {remap}
-  <include file="$(find mujoco_driver)/launch/inc/control_stack.launch.xml">
+  <include file="$(find control_stack)/launch/inc/control_stack.launch.xml">
     <arg name="description_args" value="$(find {pkg})/config/description.args"/>
     <arg name="jog_arm_config" value="$(find {pkg})/config/jog_arm_hardware.yaml"/>
     <arg name="contact_control_config" value="$(find {pkg})/config/contact_control_hardware.yaml"/>
@@ -607,6 +610,7 @@ def _launch_file(
     <arg name="with_state_publisher" value="$(arg with_state_publisher)"/>
     <arg name="with_jog_arm" value="$(arg with_jog_arm)"/>
     <arg name="with_contact_control" value="$(arg with_contact_control)"/>
+    <arg name="single_process" value="$(arg single_process)"/>
     <arg name="output" value="$(arg output)"/>
   </include>
 {named_poses_comment}

@@ -9,7 +9,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pinocchio as pin
 import pytest
-from mujoco_driver.description import (
+from control_stack.description import (
     ERD_ENV,
     DescriptionError,
     ToolSpec,
@@ -123,7 +123,7 @@ def test_find_example_robot_data_env_var_first_and_clear_error(tmp_path, monkeyp
     monkeypatch.setenv(ERD_ENV, str(tmp_path))
     assert find_example_robot_data() == str(tmp_path)
     monkeypatch.setenv(ERD_ENV, str(tmp_path / "missing"))
-    monkeypatch.setattr("mujoco_driver.description._site_package_dirs", lambda: [])
+    monkeypatch.setattr("control_stack.description._site_package_dirs", lambda: [])
     with pytest.raises(DescriptionError, match=ERD_ENV):
         find_example_robot_data(str(tmp_path))
 
