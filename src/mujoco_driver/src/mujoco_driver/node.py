@@ -3,14 +3,13 @@
 One loop in the main thread steps the simulation in real time (a fixed wall-clock grid, see
 :mod:`mujoco_driver.pacing`) and publishes the state; subscriber and service callbacks run in rospy's
 threads and only call into the simulation while holding ``_lock`` (``Simulation`` is not thread-safe).
-Messages and arrays are allocated once; the loop fills them in place.
+Messages and arrays are allocated once; the loop fills them in place. With ``~profile`` the node speaks as a
+real driver through an :class:`~mujoco_driver.emulated_driver.EmulatedDriver` it owns.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import faulthandler
-import functools
 import math
 import os
 import signal
@@ -21,26 +20,24 @@ from typing import Any
 
 import numpy as np
 import rospy
-import rospy.impl.simtime as simtime
+from compliant_common.clock_source import drop_clock_subscription, set_rostime
 from compliant_common.master import MasterWatch
 from compliant_common.runtime import tune_runtime
 from compliant_control_msgs.srv import PushEEF, PushEEFResponse
-from geometry_msgs.msg import PoseStamped, TransformStamped, WrenchStamped
+from geometry_msgs.msg import PoseStamped, WrenchStamped
 from rosgraph_msgs.msg import Clock
-from rospy.rostime import _set_rostime
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64, Float64MultiArray, MultiArrayDimension, String
+from std_msgs.msg import Float64, Float64MultiArray, MultiArrayDimension
 from std_srvs.srv import Trigger, TriggerResponse
-from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectory
 
 from mujoco_driver.commands import trajectory_points, velocity_vector
 from mujoco_driver.config import ConfigError, SceneConfig
-from mujoco_driver.emulation import DriverEmulation
+from mujoco_driver.emulated_driver import EmulatedDriver, resolve_profile
 from mujoco_driver.latency import LatencyProbe
 from mujoco_driver.pacing import Pacer, RtfMeter, TrailingPublication
 from mujoco_driver.params import DriverSettings, ParamError, load_scene, urdf_root_link
-from mujoco_driver.profiles import DriverProfile, ProfileError, load_profile, option_params
+from mujoco_driver.profiles import DriverProfile, ProfileError
 from mujoco_driver.scene import SceneError
 from mujoco_driver.sim import CommandError, Simulation
 
@@ -57,7 +54,8 @@ _CATCH_UP_LAG = 0.002
 
 
 class MujocoDriverNode:
-    """Topics, services and the stepping loop around one :class:`Simulation`.
+    """Topics, services, the viewer and the stepping loop around one :class:`Simulation`; what a real driver
+    offers besides (controllers, tf, reflex...) is its :class:`EmulatedDriver`'s.
 
     Args:
         settings: The validated node parameters.
@@ -80,7 +78,8 @@ class MujocoDriverNode:
         self._lock = threading.Lock()
         self._base_frame = s.base_frame or urdf_root_link(urdf)
         self._clock_offset = 0.0  # simulated time before the last ~reset, so /clock never runs backwards
-        self._emu = DriverEmulation(sim, profile) if profile is not None else None
+        # Made before anything is advertised: it refuses a profile naming links the description lacks.
+        self._driver = EmulatedDriver(sim, profile, self._lock) if profile is not None else None
         # Steps per publication; fractional for a profile's rate (30 Hz on 2 ms steps), exact on average.
         self._publish_every = (profile.publish_steps(sim.dt) if profile is not None
                                else s.publish_every(sim.dt))
@@ -98,6 +97,8 @@ class MujocoDriverNode:
         self._qpos_adr, self._dof_adr = scene.qpos_adr, scene.dof_adr
         self._xpos_src, self._xquat_src = data.xpos[scene.eef_body], data.xquat[scene.eef_body]
         self._sim_time = 0.0
+        # The published wrench: the simulated sensor's, or the emulated driver's (both filled in place).
+        self._wrench_out = self._w if self._driver is None else self._driver.wrench
 
         # Preallocated messages.
         self._joint_msg = JointState(name=list(sim.joint_names))
@@ -130,37 +131,25 @@ class MujocoDriverNode:
         self._rtf_pub = publisher("~rtf", Float64)
         self._latency_pub = publisher("~command_latency", Float64MultiArray)
         self._clock_pub = publisher("/clock", Clock) if s.publish_clock else None
-        if self._clock_pub is not None and getattr(simtime, "_clock_sub", None) is not None:
-            simtime._clock_sub.unregister()  # see _publish_clock
-            simtime._clock_sub = None
-        if profile is None:  # no emulation (self._emu is None)
+        if self._clock_pub is not None:
+            drop_clock_subscription()  # see _publish_clock
+        if self._driver is None:
             self._subs = [
                 rospy.Subscriber(s.trajectory_command_topic, JointTrajectory, self._on_trajectory,
                                  queue_size=1, tcp_nodelay=True),
                 rospy.Subscriber(s.velocity_command_topic, Float64MultiArray, self._on_velocity,
                                  queue_size=1, tcp_nodelay=True),
             ]
-        else:  # one command topic per controller, as ros_control: <controller>/command
-            kinds = {"trajectory": (JointTrajectory, self._on_trajectory),
-                     "velocity": (Float64MultiArray, self._on_velocity)}
-            self._subs = [
-                rospy.Subscriber(f"{c.name}/command", kinds[c.command][0],
-                                 functools.partial(kinds[c.command][1], controller=c.name),
-                                 queue_size=1, tcp_nodelay=True)
-                for c in profile.controllers if c.command != "none"
-            ]
+        else:
+            self._subs = self._driver.subscribe_commands(self._on_trajectory, self._on_velocity)
         self._subs.append(rospy.Subscriber("~push_wrench", WrenchStamped, self._on_push_wrench, queue_size=1,
                                            tcp_nodelay=True))
         self._services = [
             rospy.Service("~push", PushEEF, self._on_push),
             rospy.Service("~reset", Trigger, self._on_reset),
         ]
-        self._tf_pub: rospy.Publisher | None = None
-        self._scaling_pub: rospy.Publisher | None = None
-        self._mode_pub: rospy.Publisher | None = None
-        self._recovery: Any = None  # actionlib.SimpleActionServer with a reflex
-        if profile is not None:  # self._emu is not None
-            self._setup_emulation(profile, publisher)
+        if self._driver is not None:
+            self._driver.advertise(publisher)
         self._viewer = self._open_viewer() if s.viewer else None
         self._warned: dict[str, int] = {}
         self._last_warning: dict[str, float] = {}
@@ -219,8 +208,8 @@ class MujocoDriverNode:
                 else:
                     self._sim_time = sim.time
             pacer.step_done()
-            if publish and tripped:
-                self._on_reflex()
+            if tripped and self._driver is not None:  # only a publishing step reads the state
+                self._driver.on_reflex()
             if self._clock_pub is not None and not catching_up:
                 self._publish_clock()
             if publish:
@@ -256,7 +245,7 @@ class MujocoDriverNode:
         self._xpos[:] = self._xpos_src
         self._xquat[:] = self._xquat_src
         self._sim_time = sim.time
-        return self._emu.update(self._w) if self._emu is not None else False
+        return self._driver.update(self._w) if self._driver is not None else False
 
     def _now(self) -> float:
         """The stamp clock [s]: simulated time with /clock, else the wall clock."""
@@ -274,14 +263,13 @@ class MujocoDriverNode:
         assert self._clock_pub is not None  # called only with a /clock publisher
         self._clock_pub.publish(self._clock_msg)
         # This node's own rospy clock: set directly instead of through its /clock subscription (dropped in
-        # __init__), which would deserialise every message this loop publishes. A fresh Time, because rospy
-        # hands the object itself to callers of rospy.Time.now().
-        _set_rostime(rospy.Time(self._stamp.secs, self._stamp.nsecs))
+        # __init__), which would deserialise every message this loop publishes. rospy keeps a copy.
+        set_rostime(self._stamp)
 
     def _publish_wrench(self) -> None:
         """The wrench of the state just read: it starts the force-control chain, so it goes out first."""
         self._set_stamp()
-        w, msg = (self._w if self._emu is None else self._emu.wrench), self._wrench_msg
+        w, msg = self._wrench_out, self._wrench_msg
         msg.header.stamp = self._stamp
         f, t = msg.wrench.force, msg.wrench.torque
         f.x, f.y, f.z, t.x, t.y, t.z = w.tolist()
@@ -296,8 +284,8 @@ class MujocoDriverNode:
         # Lists serialise fastest in genpy (numpy scalars go through a slower path).
         joint.position, joint.velocity, joint.effort = self._q.tolist(), self._qd.tolist(), self._tau.tolist()
         self._joint_pub.publish(joint)
-        if self._tf_pub is not None:
-            self._publish_emulated_state()
+        if self._driver is not None:
+            self._driver.publish_state(self._state_stamp)
         self._pose_countdown -= 1
         if self._pose_countdown > 0:
             return
@@ -364,9 +352,9 @@ class MujocoDriverNode:
     def _refused(self, controller: str | None) -> bool:
         """Under the lock: an emulated driver ignores commands to a controller that is not running, and all
         of them after a reflex (warned, throttled)."""
-        if controller is None or self._emu is None:
+        if controller is None or self._driver is None:
             return False
-        reason = self._emu.refusal(controller)
+        reason = self._driver.refusal(controller)
         if reason:
             self._reject(f"{controller} command", CommandError(reason))
         return bool(reason)
@@ -438,113 +426,12 @@ class MujocoDriverNode:
                    f"({self._base_frame}) for {req.duration:g} s")
         return PushEEFResponse(success=True, message=message)
 
-    # ------------------------------------------------------------- emulation
-    def _setup_emulation(self, profile: DriverProfile, publisher: Any) -> None:
-        """The real driver's extra topics and services (see the README's *Driver emulation*)."""
-        from controller_manager_msgs.srv import ListControllers, SwitchController
-
-        assert self._emu is not None
-        self._tf_pub = publisher("/tf", TFMessage)
-        self._tf_msg = TFMessage(transforms=[TransformStamped() for _ in profile.tf])
-        for t, spec in zip(self._tf_msg.transforms, profile.tf, strict=True):
-            t.header.frame_id, t.child_frame_id = spec.parent, spec.child
-        if profile.speed_scaling_topic:
-            self._scaling_pub = publisher(profile.speed_scaling_topic, Float64)
-            self._scaling_msg = Float64(1.0)
-        cm = profile.controller_manager
-        self._services += [
-            rospy.Service(f"{cm}/list_controllers", ListControllers, self._on_list_controllers),
-            rospy.Service(f"{cm}/switch_controller", SwitchController, self._on_switch_controller),
-        ]
-        if profile.wrench.zero_service:
-            self._services.append(rospy.Service(profile.wrench.zero_service, Trigger, self._on_zero))
-        if profile.reflex is not None:
-            import actionlib
-            from driver_emulation_msgs.msg import ErrorRecoveryAction
-
-            self._mode_pub = rospy.Publisher("~robot_mode", String, queue_size=1, latch=True)
-            self._mode_pub.publish(String("move"))
-            self._recovery = actionlib.SimpleActionServer(profile.reflex.recovery_action, ErrorRecoveryAction,
-                                                          self._on_recovery, auto_start=False)
-            self._recovery.start()
-        rospy.loginfo("mujoco_driver: speaking as %s (%s): %.0f Hz, wrench %s in %s (%s), running %s",
-                      profile.driver, dict(profile.options), profile.publish_rate, profile.wrench.topic,
-                      profile.wrench.frame, profile.wrench.model, self._emu.controllers.running())
-
-    def _publish_emulated_state(self) -> None:
-        """tf and speed scaling with the joint state they belong to (same stamp)."""
-        assert self._emu is not None and self._tf_pub is not None  # both made by _setup_emulation
-        for t, (pos, quat) in zip(self._tf_msg.transforms, self._emu.transforms, strict=True):
-            t.header.stamp = self._state_stamp
-            tr, rot = t.transform.translation, t.transform.rotation
-            tr.x, tr.y, tr.z = pos.tolist()
-            rot.x, rot.y, rot.z, rot.w = quat.tolist()
-        if self._tf_msg.transforms:
-            self._tf_pub.publish(self._tf_msg)
-        if self._scaling_pub is not None:
-            self._scaling_pub.publish(self._scaling_msg)
-
-    def _on_reflex(self) -> None:
-        emu = self._emu  # a reflex tripped: emulation with a reflex, so the ~robot_mode publisher exists
-        assert emu is not None and emu.reflex is not None and emu.profile.reflex is not None
-        assert self._mode_pub is not None
-        rospy.logerr("mujoco_driver: %s: the arm stopped; commands are ignored until %s is called",
-                     emu.reflex.reason, emu.profile.reflex.recovery_action)
-        self._mode_pub.publish(String("reflex"))
-
-    def _on_recovery(self, _goal: Any) -> None:
-        # The recovery action server exists only with an emulated reflex.
-        assert self._emu is not None and self._mode_pub is not None
-        with self._lock:
-            recovered = self._emu.recover()
-        if recovered:
-            rospy.loginfo("mujoco_driver: error recovery: the arm takes commands again")
-        self._mode_pub.publish(String("move"))
-        self._recovery.set_succeeded()
-
-    def _on_list_controllers(self, _req: Any) -> Any:
-        from controller_manager_msgs.msg import ControllerState, HardwareInterfaceResources
-        from controller_manager_msgs.srv import ListControllersResponse
-
-        assert self._emu is not None  # the controller_manager services exist only with emulation
-        with self._lock:
-            listing = self._emu.controllers.listing()
-        states = []
-        for spec, state, joints in listing:
-            claimed = ([HardwareInterfaceResources(spec.hardware_interface, joints)]
-                       if spec.hardware_interface else [])
-            states.append(ControllerState(name=spec.name, state=state, type=spec.type,
-                                          claimed_resources=claimed))
-        return ListControllersResponse(controller=states)
-
-    def _on_switch_controller(self, req: Any) -> Any:
-        from controller_manager_msgs.srv import SwitchControllerResponse
-
-        assert self._emu is not None
-        with self._lock:
-            result = self._emu.switch(list(req.start_controllers), list(req.stop_controllers), req.strictness)
-            running = self._emu.controllers.running()
-        if result.ok:
-            rospy.loginfo("mujoco_driver: switched controllers: started %s, stopped %s; running %s%s",
-                          result.started, result.stopped, running,
-                          f" ({result.message})" if result.message else "")
-        else:
-            rospy.logerr("mujoco_driver: switch_controller refused: %s", result.message)
-        return SwitchControllerResponse(ok=result.ok)
-
-    def _on_zero(self, _req: Any) -> TriggerResponse:
-        assert self._emu is not None  # the zero service exists only with emulation
-        with self._lock:
-            self._emu.zero()
-        return TriggerResponse(success=True, message="the force/torque sensor reads zero now")
-
     def _on_reset(self, _req: Any) -> TriggerResponse:
         with self._lock:
             self._clock_offset += self._sim.time
             self._sim.reset()
-            if self._emu is not None and self._emu.recover():  # back at the start: no reflex either
-                assert self._mode_pub is not None  # there was a reflex to recover from
-                self._mode_pub.publish(String("move"))
+            if self._driver is not None:
+                self._driver.reset()
             self._velocity_active = False
             self._read_state()
         return TriggerResponse(success=True, message="back at the start pose, holding position")
@@ -578,18 +465,7 @@ def main(argv: list[str] | None = None) -> int:
         if not rospy.has_param(key):
             raise ParamError(f"{rospy.resolve_name('robot_description')} is not set (the URDF)")
         urdf = rospy.get_param(key)
-        profile = None
-        if settings.profile:
-            options = dict(settings.profile_options or {})
-            for option, name in option_params(settings.profile).items():
-                if option not in options and rospy.has_param(name):  # the driver configuration's value
-                    options[option] = rospy.get_param(name)
-                    rospy.loginfo("mujoco_driver: option %s = %r from parameter %s", option, options[option],
-                                  rospy.resolve_name(name))
-            profile = load_profile(settings.profile, options)
-            # The real driver's names win over the driver's own topic parameters.
-            settings = dataclasses.replace(settings, joint_states_topic=profile.joint_states_topic,
-                                           wrench_topic=profile.wrench.topic, ft_frame=profile.wrench.frame)
+        settings, profile = resolve_profile(settings)  # with ~profile, the real driver's topic names
         node = MujocoDriverNode(settings, urdf, load_scene(settings), profile)
     except (ParamError, ConfigError, SceneError, ProfileError) as exc:
         rospy.logfatal("mujoco_driver: %s", exc)

@@ -1,0 +1,205 @@
+"""The ROS side of driver emulation (see the README's *Driver emulation*), around the pure
+:class:`~mujoco_driver.emulation.DriverEmulation`: the profile resolved from the node's parameters, and what
+a real driver offers besides joint states, the wrench and command handling, which stay with the node.
+
+The node owns one :class:`EmulatedDriver` when ``~profile`` is set and calls it from its loop (under its
+simulation lock where a method says so); the services and the action take that lock themselves.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import threading
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import rospy
+from geometry_msgs.msg import TransformStamped
+from std_msgs.msg import Float64, Float64MultiArray, String
+from std_srvs.srv import Trigger, TriggerResponse
+from tf2_msgs.msg import TFMessage
+from trajectory_msgs.msg import JointTrajectory
+
+from mujoco_driver.emulation import DriverEmulation
+from mujoco_driver.params import DriverSettings
+from mujoco_driver.profiles import DriverProfile, load_profile, option_params
+from mujoco_driver.sim import Simulation
+
+__all__ = ["EmulatedDriver", "PublisherFactory", "resolve_profile"]
+
+#: The node's way of making publishers (its queue size and TCP_NODELAY), used for the driver's too.
+PublisherFactory = Callable[[str, type], rospy.Publisher]
+#: A node command callback: (message, controller=<name>).
+CommandCallback = Callable[..., None]
+
+
+def resolve_profile(settings: DriverSettings) -> tuple[DriverSettings, DriverProfile | None]:
+    """The profile ``~profile`` names (None: not emulating) and the settings with its real driver's names.
+
+    Options the user's ``~profile_options`` leave unset are read from the parameters the real driver reads
+    them from (the profile's ``option_params``), so a robot package's driver configuration reaches the
+    emulation as it reaches the real driver.
+
+    Raises:
+        ProfileError: No such profile, or a bad option.
+    """
+    if not settings.profile:
+        return settings, None
+    options = dict(settings.profile_options or {})
+    for option, name in option_params(settings.profile).items():
+        if option not in options and rospy.has_param(name):  # the driver configuration's value
+            options[option] = rospy.get_param(name)
+            rospy.loginfo("mujoco_driver: option %s = %r from parameter %s", option, options[option],
+                          rospy.resolve_name(name))
+    profile = load_profile(settings.profile, options)
+    # The real driver's names win over the driver's own topic parameters.
+    settings = dataclasses.replace(settings, joint_states_topic=profile.joint_states_topic,
+                                   wrench_topic=profile.wrench.topic, ft_frame=profile.wrench.frame)
+    return settings, profile
+
+
+class EmulatedDriver:
+    """A real driver's controllers, tf, speed scaling, wrench zeroing and reflex on one simulation.
+
+    Args:
+        sim: The simulation (called only under ``lock``).
+        profile: The resolved profile.
+        lock: The node's simulation lock.
+
+    Raises:
+        ProfileError: If the profile names links the description lacks (before anything is advertised).
+    """
+
+    def __init__(self, sim: Simulation, profile: DriverProfile, lock: threading.Lock) -> None:
+        self.profile = profile
+        self._emu = emu = DriverEmulation(sim, profile)
+        self._lock = lock
+        #: What the driver publishes as its wrench [N, Nm]; :attr:`update` fills it in place.
+        self.wrench: np.ndarray = emu.wrench
+        # The pure core's own methods, bound here so the loop pays no extra call per publication.
+        #: Under the lock, at every publication: sensor wrench -> True when the reflex tripped.
+        self.update: Callable[[np.ndarray], bool] = emu.update
+        #: Under the lock: why a command to a controller does not move the arm now ("" = it does).
+        self.refusal: Callable[[str], str] = emu.refusal
+        self._tf_msg = TFMessage(transforms=[TransformStamped() for _ in profile.tf])
+        for t, spec in zip(self._tf_msg.transforms, profile.tf, strict=True):
+            t.header.frame_id, t.child_frame_id = spec.parent, spec.child
+        self._scaling_msg = Float64(1.0)
+        self._tf_pub: rospy.Publisher | None = None
+        self._scaling_pub: rospy.Publisher | None = None
+        self._mode_pub: rospy.Publisher | None = None  # with a reflex
+        self._recovery: Any = None  # actionlib.SimpleActionServer, with a reflex
+        self._services: list[rospy.Service] = []
+
+    def subscribe_commands(self, on_trajectory: CommandCallback,
+                           on_velocity: CommandCallback) -> list[rospy.Subscriber]:
+        """One command topic per command controller, as ros_control: ``<controller>/command``; the node's
+        callback gets ``controller=<name>`` to ask :attr:`refusal`."""
+        kinds = {"trajectory": (JointTrajectory, on_trajectory), "velocity": (Float64MultiArray, on_velocity)}
+        return [
+            rospy.Subscriber(f"{c.name}/command", kinds[c.command][0],
+                             functools.partial(kinds[c.command][1], controller=c.name),
+                             queue_size=1, tcp_nodelay=True)
+            for c in self.profile.controllers if c.command != "none"
+        ]
+
+    def advertise(self, publisher: PublisherFactory) -> None:
+        """The real driver's other topics, services and action (the node calls it after its own)."""
+        from controller_manager_msgs.srv import ListControllers, SwitchController
+
+        profile = self.profile
+        self._tf_pub = publisher("/tf", TFMessage)
+        if profile.speed_scaling_topic:
+            self._scaling_pub = publisher(profile.speed_scaling_topic, Float64)
+        cm = profile.controller_manager
+        self._services += [
+            rospy.Service(f"{cm}/list_controllers", ListControllers, self._on_list_controllers),
+            rospy.Service(f"{cm}/switch_controller", SwitchController, self._on_switch_controller),
+        ]
+        if profile.wrench.zero_service:
+            self._services.append(rospy.Service(profile.wrench.zero_service, Trigger, self._on_zero))
+        if profile.reflex is not None:
+            import actionlib
+            from driver_emulation_msgs.msg import ErrorRecoveryAction
+
+            self._mode_pub = rospy.Publisher("~robot_mode", String, queue_size=1, latch=True)
+            self._mode_pub.publish(String("move"))
+            self._recovery = actionlib.SimpleActionServer(profile.reflex.recovery_action, ErrorRecoveryAction,
+                                                          self._on_recovery, auto_start=False)
+            self._recovery.start()
+        rospy.loginfo("mujoco_driver: speaking as %s (%s): %.0f Hz, wrench %s in %s (%s), running %s",
+                      profile.driver, dict(profile.options), profile.publish_rate, profile.wrench.topic,
+                      profile.wrench.frame, profile.wrench.model, self._emu.controllers.running())
+
+    # ------------------------------------------------------------- from the loop
+    def publish_state(self, stamp: rospy.Time) -> None:
+        """tf and speed scaling with the joint state they belong to (same stamp)."""
+        assert self._tf_pub is not None  # made by advertise
+        for t, (pos, quat) in zip(self._tf_msg.transforms, self._emu.transforms, strict=True):
+            t.header.stamp = stamp
+            tr, rot = t.transform.translation, t.transform.rotation
+            tr.x, tr.y, tr.z = pos.tolist()
+            rot.x, rot.y, rot.z, rot.w = quat.tolist()
+        if self._tf_msg.transforms:
+            self._tf_pub.publish(self._tf_msg)
+        if self._scaling_pub is not None:
+            self._scaling_pub.publish(self._scaling_msg)
+
+    def on_reflex(self) -> None:
+        """The reflex tripped at the last :attr:`update` (outside the lock): say so."""
+        reflex, spec = self._emu.reflex, self.profile.reflex  # a reflex tripped: both exist, and ~robot_mode
+        assert reflex is not None and spec is not None and self._mode_pub is not None
+        rospy.logerr("mujoco_driver: %s: the arm stopped; commands are ignored until %s is called",
+                     reflex.reason, spec.recovery_action)
+        self._mode_pub.publish(String("reflex"))
+
+    def reset(self) -> None:
+        """Under the lock, after the simulation's reset: back at the start, so no reflex either."""
+        if self._emu.recover():
+            assert self._mode_pub is not None  # there was a reflex to recover from
+            self._mode_pub.publish(String("move"))
+
+    # ------------------------------------------------------ services and action
+    def _on_recovery(self, _goal: Any) -> None:
+        assert self._mode_pub is not None  # the action server exists only with a reflex
+        with self._lock:
+            recovered = self._emu.recover()
+        if recovered:
+            rospy.loginfo("mujoco_driver: error recovery: the arm takes commands again")
+        self._mode_pub.publish(String("move"))
+        self._recovery.set_succeeded()
+
+    def _on_list_controllers(self, _req: Any) -> Any:
+        from controller_manager_msgs.msg import ControllerState, HardwareInterfaceResources
+        from controller_manager_msgs.srv import ListControllersResponse
+
+        with self._lock:
+            listing = self._emu.controllers.listing()
+        states = []
+        for spec, state, joints in listing:
+            claimed = ([HardwareInterfaceResources(spec.hardware_interface, joints)]
+                       if spec.hardware_interface else [])
+            states.append(ControllerState(name=spec.name, state=state, type=spec.type,
+                                          claimed_resources=claimed))
+        return ListControllersResponse(controller=states)
+
+    def _on_switch_controller(self, req: Any) -> Any:
+        from controller_manager_msgs.srv import SwitchControllerResponse
+
+        with self._lock:
+            result = self._emu.switch(list(req.start_controllers), list(req.stop_controllers), req.strictness)
+            running = self._emu.controllers.running()
+        if result.ok:
+            rospy.loginfo("mujoco_driver: switched controllers: started %s, stopped %s; running %s%s",
+                          result.started, result.stopped, running,
+                          f" ({result.message})" if result.message else "")
+        else:
+            rospy.logerr("mujoco_driver: switch_controller refused: %s", result.message)
+        return SwitchControllerResponse(ok=result.ok)
+
+    def _on_zero(self, _req: Any) -> TriggerResponse:
+        with self._lock:
+            self._emu.zero()
+        return TriggerResponse(success=True, message="the force/torque sensor reads zero now")

@@ -1,0 +1,67 @@
+"""clock_source relies on private rospy (see the module for why): these fail when rospy changes what it relies
+on, i.e. where init_node keeps its /clock subscription and what setting the clock does. No master: rospy's
+time globals are put back after each test."""
+
+import threading
+
+import pytest
+import rospy
+import rospy.client
+import rospy.impl.simtime as simtime
+import rospy.rostime
+import rospy.topics
+from rosgraph_msgs.msg import Clock
+
+from compliant_common import clock_source
+
+
+@pytest.fixture
+def rospy_time(monkeypatch: pytest.MonkeyPatch) -> None:
+    """rospy's clock initialised and on the wall clock, as after init_node without /use_sim_time."""
+    monkeypatch.setattr(rospy.rostime, "_rostime_initialized", True)
+    monkeypatch.setattr(rospy.rostime, "_rostime_current", None)
+
+
+class _Subscriber:
+    def __init__(self, topic: str, data_class: type, callback, queue_size: int | None = None) -> None:
+        self.topic, self.data_class, self.callback = topic, data_class, callback
+        self.unregistered = False
+
+    def unregister(self) -> None:
+        self.unregistered = True
+
+
+def test_the_clock_subscription_init_node_makes_under_sim_time_is_the_one_dropped(monkeypatch, rospy_time):
+    assert "init_simtime" in rospy.client.init_node.__code__.co_names  # init_node makes it with this
+    made: list[_Subscriber] = []
+
+    def subscribe(*args, **kwargs) -> _Subscriber:
+        made.append(_Subscriber(*args, **kwargs))
+        return made[-1]
+
+    monkeypatch.setattr(rospy.topics, "Subscriber", subscribe)
+    monkeypatch.setattr(simtime, "_is_use_simtime", lambda: True)
+    monkeypatch.setattr(simtime, "_clock_sub", None, raising=False)
+    assert clock_source.drop_clock_subscription() is False  # none yet
+    assert simtime.init_simtime()
+    [sub] = made
+    assert (sub.topic, sub.data_class) == ("/clock", Clock)
+    sub.callback(Clock(rospy.Time(7, 5)))  # that subscription is what moves this process's clock
+    assert rospy.Time.now() == rospy.Time(7, 5)
+    assert clock_source.drop_clock_subscription() is True
+    assert sub.unregistered and clock_source.drop_clock_subscription() is False
+
+
+def test_set_rostime_moves_this_process_clock_to_a_copy_and_wakes_sleepers(rospy_time):
+    stamp = rospy.Time(12, 500)
+    clock_source.set_rostime(stamp)
+    assert not rospy.rostime.is_wallclock() and rospy.Time.now() == rospy.Time(12, 500)
+    stamp.secs = 99  # the node fills its one stamp object in place at every step
+    assert rospy.get_time() == pytest.approx(12.0000005)
+    cond = rospy.rostime.get_rostime_cond()  # what rospy.sleep and rospy.Rate wait on under sim time
+    with cond:
+        setter = threading.Thread(target=clock_source.set_rostime, args=(rospy.Time(13),))
+        setter.start()
+        assert cond.wait(timeout=5.0), "setting the clock did not wake a waiting rospy.sleep"
+    setter.join()
+    assert rospy.get_time() == 13.0

@@ -1,0 +1,184 @@
+"""The emulated driver's ROS side without a master: rospy's Publisher, Subscriber and Service and actionlib's
+server replaced by recorders, on both simulated robots speaking as their drivers (the UR5 as
+ur_robot_driver: speed scaling, zeroing, a velocity controller loaded but not started; the Panda as
+franka_ros: tf frames, a reflex and its recovery action). The end-to-end run is
+tests/robot_packages/test_robot_emulated_drivers.py."""
+
+from __future__ import annotations
+
+import threading
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+import pytest
+
+pytest.importorskip("controller_manager_msgs.srv", reason="needs devel/setup.bash (make test sources it)")
+
+import actionlib
+import rospy
+from mujoco_driver.controllers import STRICT
+from mujoco_driver.emulated_driver import EmulatedDriver, resolve_profile
+from mujoco_driver.params import DriverSettings
+from mujoco_driver.profiles import load_profile
+from std_msgs.msg import Float64MultiArray
+from trajectory_msgs.msg import JointTrajectory
+
+PROFILE_FOR = {"ur5_custom": "ur_robot_driver", "panda_custom": "franka_ros"}
+
+
+class _Graph:
+    """What was advertised, by name."""
+
+    def __init__(self) -> None:
+        self.publishers: dict[str, Any] = {}
+        self.subscribers: dict[str, Any] = {}
+        self.services: dict[str, Any] = {}
+        self.actions: dict[str, Any] = {}
+
+
+@pytest.fixture
+def graph(monkeypatch: pytest.MonkeyPatch) -> _Graph:
+    g = _Graph()
+
+    class Publisher:
+        def __init__(self, name: str, data_class: type, **kwargs: Any) -> None:
+            self.data_class, self.kwargs, self.sent = data_class, kwargs, []
+            g.publishers[name] = self
+
+        def publish(self, msg: Any) -> None:
+            self.sent.append(msg)
+
+    class Subscriber:
+        def __init__(self, name: str, data_class: type, callback: Any, **kwargs: Any) -> None:
+            self.data_class, self.callback, self.kwargs = data_class, callback, kwargs
+            g.subscribers[name] = self
+
+    class Service:
+        def __init__(self, name: str, service_class: type, handler: Any) -> None:
+            self.service_class, self.handler = service_class, handler
+            g.services[name] = self
+
+    class ActionServer:
+        def __init__(self, name: str, action: type, execute_cb: Any, auto_start: bool = True) -> None:
+            self.execute, self.started, self.succeeded = execute_cb, auto_start, 0
+            g.actions[name] = self
+
+        def start(self) -> None:
+            self.started = True
+
+        def set_succeeded(self) -> None:
+            self.succeeded += 1
+
+    for name, cls in (("Publisher", Publisher), ("Subscriber", Subscriber), ("Service", Service)):
+        monkeypatch.setattr(rospy, name, cls)
+    monkeypatch.setattr(actionlib, "SimpleActionServer", ActionServer)
+    return g
+
+
+def _driver(sim, robot, graph: _Graph) -> EmulatedDriver:
+    driver = EmulatedDriver(sim, load_profile(PROFILE_FOR[robot.package]), threading.Lock())
+    driver.advertise(lambda name, cls: rospy.Publisher(name, cls, queue_size=10, tcp_nodelay=True))
+    return driver
+
+
+def test_each_command_controller_has_its_topic_and_the_callback_learns_its_name(sim, robot, graph):
+    driver = EmulatedDriver(sim, load_profile(PROFILE_FOR[robot.package]), threading.Lock())
+    got: list[tuple[str, str]] = []
+    driver.subscribe_commands(lambda msg, controller: got.append(("trajectory", controller)),
+                              lambda msg, controller: got.append(("velocity", controller)))
+    topics = {name: sub.data_class for name, sub in graph.subscribers.items()}
+    if robot.package == "ur5_custom":
+        assert topics == {"scaled_pos_joint_traj_controller/command": JointTrajectory,
+                          "joint_group_vel_controller/command": Float64MultiArray}
+    else:
+        assert topics == {"position_joint_trajectory_controller/command": JointTrajectory}
+    for name, sub in graph.subscribers.items():
+        assert sub.kwargs == {"queue_size": 1, "tcp_nodelay": True}
+        sub.callback(sub.data_class())
+        assert got[-1] == ("trajectory" if sub.data_class is JointTrajectory else "velocity", name[:-8])
+    assert not graph.publishers and not graph.services  # advertise() comes after the node's own
+
+
+def test_the_real_drivers_topics_services_and_action_are_advertised(sim, robot, graph):
+    _driver(sim, robot, graph)
+    cm = ["controller_manager/list_controllers", "controller_manager/switch_controller"]
+    if robot.package == "ur5_custom":
+        assert sorted(graph.publishers) == ["/tf", "speed_scaling_factor"]
+        assert sorted(graph.services) == [*cm, "ur_hardware_interface/zero_ftsensor"]
+        assert not graph.actions
+    else:
+        assert sorted(graph.publishers) == ["/tf", "~robot_mode"]
+        assert sorted(graph.services) == cm
+        mode = graph.publishers["~robot_mode"]
+        assert mode.kwargs == {"queue_size": 1, "latch": True} and [m.data for m in mode.sent] == ["move"]
+        assert graph.actions["franka_control/error_recovery"].started
+
+
+def test_controllers_are_listed_and_switched_through_the_services(sim, robot, graph):
+    driver = _driver(sim, robot, graph)
+    listed = graph.services["controller_manager/list_controllers"].handler(None).controller
+    states = {c.name: c.state for c in listed}
+    if robot.package != "ur5_custom":
+        assert states == dict.fromkeys(["franka_state_controller", "position_joint_trajectory_controller"],
+                                       "running")
+        return
+    assert states["joint_group_vel_controller"] == "initialized"
+    assert "joint_group_vel_controller is initialized" in driver.refusal("joint_group_vel_controller")
+    claimed = {c.name: [r.resources for r in c.claimed_resources] for c in listed}
+    assert claimed["scaled_pos_joint_traj_controller"] == [list(sim.joint_names)]
+    switch = graph.services["controller_manager/switch_controller"].handler
+    req = SimpleNamespace(start_controllers=["joint_group_vel_controller"],
+                          stop_controllers=["scaled_pos_joint_traj_controller"], strictness=STRICT)
+    assert switch(req).ok and driver.refusal("joint_group_vel_controller") == ""
+    assert not switch(req).ok  # STRICT: already running, and the other is not
+    zero = graph.services["ur_hardware_interface/zero_ftsensor"].handler(None)
+    assert zero.success and "zero" in zero.message
+
+
+def test_the_state_goes_out_with_its_stamp_and_a_reflex_holds_the_arm_until_recovery(sim, robot, graph):
+    driver = _driver(sim, robot, graph)
+    sim.step(50)
+    assert not driver.update(np.asarray(sim.wrench()))
+    stamp = rospy.Time(3, 250)
+    driver.publish_state(stamp)
+    [tf] = graph.publishers["/tf"].sent
+    assert tf.transforms and all(t.header.stamp == stamp for t in tf.transforms)
+    if robot.package == "ur5_custom":
+        assert [m.data for m in graph.publishers["speed_scaling_factor"].sent] == [1.0]
+        return
+    assert [t.child_frame_id for t in tf.transforms] == ["panda_NE", "panda_EE", "panda_K"]
+    sim.push([0.0, 0.0, -40.0], duration=0.3)
+    tripped = False
+    for _ in range(50):
+        sim.step(10)
+        tripped = driver.update(np.asarray(sim.wrench())) or tripped
+    assert tripped
+    driver.on_reflex()
+    mode = graph.publishers["~robot_mode"]
+    assert mode.sent[-1].data == "reflex"
+    assert "franka_control/error_recovery" in driver.refusal("position_joint_trajectory_controller")
+    action = graph.actions["franka_control/error_recovery"]
+    action.execute(None)
+    assert action.succeeded == 1 and mode.sent[-1].data == "move"
+    assert driver.refusal("position_joint_trajectory_controller") == ""
+    sent = len(mode.sent)
+    driver.reset()  # no reflex to recover from: nothing to say
+    assert len(mode.sent) == sent
+
+
+def test_the_profile_takes_options_from_the_real_drivers_parameters_unless_the_user_set_them(monkeypatch):
+    params = {"franka_state_controller/publish_rate": 100.0}
+    monkeypatch.setattr(rospy, "has_param", lambda name: name in params)
+    monkeypatch.setattr(rospy, "get_param", lambda name: params[name])
+    monkeypatch.setattr(rospy, "resolve_name", lambda name: "/" + name)
+    own = DriverSettings.from_params({"scene_config": "s.yaml"})
+    assert resolve_profile(own) == (own, None)
+    settings, profile = resolve_profile(DriverSettings.from_params({"scene_config": "s.yaml",
+                                                                    "profile": "franka_ros"}))
+    assert profile is not None and profile.publish_rate == 100.0
+    assert (settings.joint_states_topic, settings.wrench_topic, settings.ft_frame) == (
+        "franka_state_controller/joint_states", "franka_state_controller/F_ext", "panda_K")
+    user = {"scene_config": "s.yaml", "profile": "franka_ros", "profile_options": {"publish_rate": 50.0}}
+    _, profile = resolve_profile(DriverSettings.from_params(user))
+    assert profile is not None and profile.publish_rate == 50.0
