@@ -83,6 +83,36 @@ def test_refused_while_a_contact_move_runs(stack):
         rospy.ServiceProxy("/contact_control_node/stop", Trigger)()
 
 
+def test_a_fresh_named_poses_node_refuses_during_a_contact_move_it_has_not_heard_of_yet(stack):
+    """Asked right after start-up, before its status subscription has delivered anything, named_poses waits
+    for contact_control's status instead of taking silence for "no contact move" (issue #21: the test above
+    passed only after others had warmed the connection)."""
+    import rospy
+    from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
+    from compliant_control_msgs.msg import ContactControlStatus
+    from compliant_control_msgs.srv import MoveToNamedPose
+    from rospkg import RosPack
+    from std_srvs.srv import Trigger
+
+    req = ConfigureForceControlRequest()
+    req.direction_control_laws.x.type = 3  # compliant move, slowly along -X
+    req.cart_impedance_params.damping.translational.x = 30.0
+    req.cart_impedance_params.max_cart_vel.set.linear.x = -0.01
+    req.cart_impedance_params.max_path_deviation.translation.x = 0.05
+    assert rospy.ServiceProxy("/configure_cartesian_impedance", ConfigureForceControl)(req).success
+    params = {"config": RosPack().get_path("ur5_custom") + "/config/named_poses.yaml",
+              "trajectory_topic": "/arm_controller/command_unused", "joint_states_topic": "/joint_states"}
+    try:
+        wait_until(lambda: rospy.wait_for_message("/contact_control_node/status", ContactControlStatus,
+                                                  5).move_active, 10, "a contact move")
+        with run_node("named_poses", "named_pose_server", params=params, name="late_poses") as late:
+            late.wait_for_service("/late_poses/move_to", timeout=30)
+            answer = rospy.ServiceProxy("/late_poses/move_to", MoveToNamedPose)(name="home", speed_scale=1.0)
+            assert not answer.success and "a contact move is running" in answer.message, answer.message
+    finally:
+        rospy.ServiceProxy("/contact_control_node/stop", Trigger)()
+
+
 def test_a_request_before_the_first_joint_state_waits_for_it_or_says_which_topic_is_silent(stack):
     """Right after start-up a request can come before the driver's first state reaches the node."""
     import rospy

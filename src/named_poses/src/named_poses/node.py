@@ -59,6 +59,9 @@ class NamedPoseServer:
         self._busy = threading.Lock()
         self._positions: dict[str, float] = {}
         self._status: ContactControlStatus | None = None
+        self._status_rx = -1.0  # monotonic time of the last status received
+        self._status_seen = threading.Condition(self._lock)
+        self._status_topic = rospy.resolve_name(settings.contact_control_status)
         self._pub = rospy.Publisher(
             settings.trajectory_topic, JointTrajectory, queue_size=1,
             tcp_nodelay=True,
@@ -84,6 +87,8 @@ class NamedPoseServer:
     def _on_status(self, msg: ContactControlStatus) -> None:
         with self._lock:
             self._status = msg
+            self._status_rx = time.monotonic()
+            self._status_seen.notify_all()
 
     def _current(self) -> np.ndarray | None:
         with self._lock:
@@ -103,8 +108,29 @@ class NamedPoseServer:
                 self._state_seen.wait(min(left, 0.1))
         return self._current()
 
-    def _contact_move_running(self) -> bool:
-        with self._lock:
+    def _status_published(self) -> bool:
+        """Whether the master knows a publisher of contact_control's status (rosgraph's public API)."""
+        try:
+            topics = rosgraph.Master(rospy.get_name()).getPublishedTopics("")
+        except (rosgraph.MasterException, OSError):  # no master answer: decide on what this node has heard
+            return self._status is not None
+        return any(topic == self._status_topic for topic, _type in topics)
+
+    def _contact_move_running(self) -> bool | None:
+        """Whether a contact move runs, from a status received after this question; None if contact_control
+        publishes its status but none came within `~state_wait`. Without contact_control: False. A status
+        heard before the question is not enough: the move may have started since, or (a fresh start) this
+        node may not be connected yet."""
+        if not self._status_published():
+            return False
+        asked = time.monotonic()
+        deadline = asked + self.state_wait
+        with self._status_seen:
+            while self._status_rx < asked:
+                left = deadline - time.monotonic()
+                if left <= 0.0 or rospy.is_shutdown():
+                    return None
+                self._status_seen.wait(min(left, 0.1))
             status = self._status
         return bool(status and (status.move_active or status.reacting))
 
@@ -125,7 +151,13 @@ class NamedPoseServer:
         scale = req.speed_scale or 1.0
         if not 0.0 < scale <= 1.0:
             return self._refuse(f"speed_scale must be in (0, 1], got {req.speed_scale}")
-        if self._contact_move_running():
+        running = self._contact_move_running()
+        if running is None:
+            return self._refuse(
+                f"no status from contact_control within {self.state_wait:g} s although it publishes "
+                f"{self._status_topic}: cannot tell whether a contact move runs"
+            )
+        if running:
             return self._refuse(
                 "a contact move is running (contact_control ~status move_active): stop it first "
                 "(rosservice call /contact_control_node/stop)"
