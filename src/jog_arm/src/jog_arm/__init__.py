@@ -3,8 +3,9 @@
 The modules here import numpy and Pinocchio only; the ROS adapter is :mod:`jog_arm.node`.
 """
 
+from jog_arm.command_state import CommandResult
 from jog_arm.filters import LowPassFilter
-from jog_arm.jog_calcs import CommandResult, JogCalcs, JogOutput
+from jog_arm.jog_calcs import JogCalcs, JogOutput
 from jog_arm.kinematics import ArmModel, KinematicsError
 from jog_arm.limits import JointLimiter, singularity_scale
 from jog_arm.settings import JogSettings, JointLimitOverride, SettingsError

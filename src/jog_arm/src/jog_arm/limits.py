@@ -156,6 +156,35 @@ class JointLimiter:
             return list(target), False
         return [p + k * (t - p) for p, t in zip(previous, target, strict=True)], True
 
+    def limit(
+        self, q: Sequence[float], dq: list[float], previous: Sequence[float], settle: bool
+    ) -> tuple[list[float], float, float]:
+        """Position, velocity, then acceleration limits for `dq` from `q`, each scaling the whole vector.
+
+        Args:
+            q: Joint positions the motion starts from [rad].
+            dq: Wanted joint velocities [rad/s].
+            previous: Last output velocities [rad/s].
+            settle: Nothing is being followed: a result within 1e-9 rad/s of rest is made exactly zero, so
+                the stop ends.
+
+        Returns:
+            The new velocities (a new list), the position scale and the velocity scale.
+        """
+        s_pos = self.position_scale(q, dq)
+        s_vel = self.velocity_scale(dq) if s_pos == 1.0 else self.velocity_scale([v * s_pos for v in dq])
+        scale = s_pos * s_vel
+        if scale < 1.0:
+            dq = [v * scale for v in dq]
+        dq_new, limited = self.limit_acceleration(previous, dq)
+        if limited:  # slowing down slower than asked might cross a stop: position beats acceleration
+            guard = self.step_scale(q, dq_new)
+            if guard < 1.0:
+                dq_new = [v * guard for v in dq_new]
+        if settle and max(map(abs, dq_new)) < 1e-9:
+            dq_new = [0.0] * len(dq_new)
+        return dq_new, s_pos, s_vel
+
     def step_scale(self, q: Sequence[float], dq: Sequence[float]) -> float:
         """Scale for `dq` so ``q + dq·period`` crosses no stop a joint moves toward (the last guard)."""
         scale = 1.0

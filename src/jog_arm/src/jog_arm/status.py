@@ -1,10 +1,11 @@
-"""Status codes of the jog_arm server; the values are those of compliant_control_msgs/JogStatus."""
+"""Status codes of the jog_arm server (the values are those of compliant_control_msgs/JogStatus), and the
+status of a cycle that follows a command."""
 
 from __future__ import annotations
 
 from enum import IntEnum
 
-__all__ = ["StatusCode"]
+__all__ = ["StatusCode", "motion_status"]
 
 
 class StatusCode(IntEnum):
@@ -22,3 +23,22 @@ class StatusCode(IntEnum):
     NO_JOINT_STATE = 9
     STALE_JOINT_STATE = 10
     CONTACT_GUARD = 11
+
+
+def motion_status(condition: float, s_sing: float, s_pos: float, s_vel: float) -> tuple[StatusCode, str]:
+    """Status of a cycle that follows a command, from the scales applied to it (a halt before a slow-down,
+    the singularity before the joint limits)."""
+    if s_sing == 0.0:
+        return StatusCode.HALT_FOR_SINGULARITY, f"halted: condition number {condition:.1f} at hard stop"
+    if s_pos == 0.0:
+        return StatusCode.HALT_FOR_JOINT_LIMIT, "halted: a joint is at its position limit margin"
+    if s_sing < 1.0:
+        return (
+            StatusCode.DECELERATE_FOR_SINGULARITY,
+            f"slowing down near a singularity: condition number {condition:.1f}",
+        )
+    if s_pos < 1.0:
+        return StatusCode.DECELERATE_FOR_JOINT_LIMIT, "slowing down near a joint position limit"
+    if s_vel < 1.0:
+        return StatusCode.JOINT_VELOCITY_SCALED, "command scaled to the joint velocity limits"
+    return StatusCode.NO_WARNING, "moving"
