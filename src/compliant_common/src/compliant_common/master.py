@@ -22,21 +22,13 @@ from typing import Any
 
 import rosgraph
 import rospy
-from rospy.impl import registration
+
+from compliant_common.rospy_internals import node_uri, publisher_update, registrations
 
 __all__ = ["MasterWatch"]
 
 PROBE_TIMEOUT = 1.0  # [s] for the master to answer one poll
 SLOW_POLLS = 3  # unanswered polls in a row that count as a lost master (a refused connection counts at once)
-
-
-def _reg_manager() -> registration.RegManager | None:
-    """rospy's RegManager of this process: it connects subscribers to publishers (it listens to every
-    registration, which is how it can be found)."""
-    listeners = registration.get_registration_listeners()
-    with listeners.lock:
-        found = [item for item in listeners.listeners if isinstance(item, registration.RegManager)]
-    return found[0] if found else None
 
 
 class _TimeoutTransport(xmlrpc.client.Transport):
@@ -120,25 +112,18 @@ class MasterWatch:
     def _restore(self) -> bool:
         """Registers everything of this process with the (new) master; False if it stopped answering."""
         master = self._proxy()
-        caller, uri = self._caller, rospy.core.get_node_uri()
-        tm, sm = registration.get_topic_manager(), registration.get_service_manager()
-        reg_man = _reg_manager()
+        caller, uri = self._caller, node_uri()
         try:
             for name, value in self._params.items():
                 if not master.hasParam(caller, name)[2]:
                     master.setParam(caller, name, value)
-            with tm.lock, sm.lock:
-                publications, subscriptions, services = (
-                    tm.get_publications(),
-                    tm.get_subscriptions(),
-                    sm.get_services(),
-                )
+            publications, subscriptions, services = registrations()
             for name, data_type in publications:
                 master.registerPublisher(caller, name, data_type, uri)
             for name, data_type in subscriptions:
                 code, _, publishers = master.registerSubscriber(caller, name, data_type, uri)
-                if code == 1 and reg_man is not None:
-                    reg_man.publisher_update(name, publishers)
+                if code == 1:
+                    publisher_update(name, publishers)
             for name, service_uri in services:
                 master.registerService(caller, name, service_uri, uri)
         except (OSError, xmlrpc.client.Error, http.client.HTTPException) as err:

@@ -8,9 +8,9 @@ from collections.abc import Callable
 from typing import Any
 
 import rospy
-from rospy.rostime import is_wallclock
 
 from compliant_common.clock import ClockJump, ClockWatch
+from compliant_common.rospy_internals import is_wallclock
 
 __all__ = ["JumpAwareClock", "MonotonicTimer", "timer"]
 

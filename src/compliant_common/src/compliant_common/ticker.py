@@ -11,7 +11,8 @@ import time
 from collections.abc import Callable
 
 import rospy
-from rospy.rostime import is_wallclock
+
+from compliant_common.rospy_internals import is_wallclock
 
 __all__ = ["start_ticker"]
 

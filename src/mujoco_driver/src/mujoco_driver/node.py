@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 import rospy
-from compliant_common.clock_source import drop_clock_subscription, set_rostime
 from compliant_common.master import MasterWatch
+from compliant_common.rospy_internals import drop_clock_subscription, set_rostime
 from compliant_common.runtime import tune_runtime
 from compliant_control_msgs.srv import PushEEF, PushEEFResponse
 from geometry_msgs.msg import PoseStamped, WrenchStamped

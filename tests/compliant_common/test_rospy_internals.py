@@ -1,6 +1,6 @@
-"""clock_source relies on private rospy (see the module for why): these fail when rospy changes what it relies
-on, i.e. where init_node keeps its /clock subscription and what setting the clock does. No master: rospy's
-time globals are put back after each test."""
+"""rospy_internals relies on private rospy (see the module for why): these fail when rospy changes what it
+relies on, i.e. where init_node keeps its /clock subscription and what setting the clock does. No master:
+rospy's time globals are put back after each test."""
 
 import threading
 
@@ -12,7 +12,7 @@ import rospy.rostime
 import rospy.topics
 from rosgraph_msgs.msg import Clock
 
-from compliant_common import clock_source
+from compliant_common import rospy_internals
 
 
 @pytest.fixture
@@ -42,26 +42,53 @@ def test_the_clock_subscription_init_node_makes_under_sim_time_is_the_one_droppe
     monkeypatch.setattr(rospy.topics, "Subscriber", subscribe)
     monkeypatch.setattr(simtime, "_is_use_simtime", lambda: True)
     monkeypatch.setattr(simtime, "_clock_sub", None, raising=False)
-    assert clock_source.drop_clock_subscription() is False  # none yet
+    assert rospy_internals.drop_clock_subscription() is False  # none yet
     assert simtime.init_simtime()
     [sub] = made
     assert (sub.topic, sub.data_class) == ("/clock", Clock)
     sub.callback(Clock(rospy.Time(7, 5)))  # that subscription is what moves this process's clock
     assert rospy.Time.now() == rospy.Time(7, 5)
-    assert clock_source.drop_clock_subscription() is True
-    assert sub.unregistered and clock_source.drop_clock_subscription() is False
+    assert rospy_internals.drop_clock_subscription() is True
+    assert sub.unregistered and rospy_internals.drop_clock_subscription() is False
 
 
 def test_set_rostime_moves_this_process_clock_to_a_copy_and_wakes_sleepers(rospy_time):
     stamp = rospy.Time(12, 500)
-    clock_source.set_rostime(stamp)
+    rospy_internals.set_rostime(stamp)
     assert not rospy.rostime.is_wallclock() and rospy.Time.now() == rospy.Time(12, 500)
     stamp.secs = 99  # the node fills its one stamp object in place at every step
     assert rospy.get_time() == pytest.approx(12.0000005)
     cond = rospy.rostime.get_rostime_cond()  # what rospy.sleep and rospy.Rate wait on under sim time
     with cond:
-        setter = threading.Thread(target=clock_source.set_rostime, args=(rospy.Time(13),))
+        setter = threading.Thread(target=rospy_internals.set_rostime, args=(rospy.Time(13),))
         setter.start()
         assert cond.wait(timeout=5.0), "setting the clock did not wake a waiting rospy.sleep"
     setter.join()
     assert rospy.get_time() == 13.0
+
+
+def test_the_registration_internals_master_watch_uses_are_there():
+    """What compliant_common.master re-registers with after a master restart (its behaviour end to end:
+    tests/robot_packages/test_robot_faults.py restarts roscore under the running stack)."""
+    from rospy.impl import registration
+
+    publications, subscriptions, services = rospy_internals.registrations()
+    assert all(isinstance(x, list) for x in (publications, subscriptions, services))
+    assert callable(rospy.core.get_node_uri)
+    assert callable(getattr(registration.RegManager, "publisher_update", None))
+    assert rospy_internals.publisher_update("/nobody", []) in (True, False)
+
+
+def test_no_other_module_in_src_touches_rospy_internals():
+    """The one place: anything private of rospy elsewhere is a bug waiting for a rospy update."""
+    import pathlib
+    import re
+
+    src = pathlib.Path(__file__).resolve().parents[2] / "src"
+    private = re.compile(r"rospy\.impl|rospy\.core\.|rospy\.rostime|_connection_header|_set_rostime|"
+                         r"from rospy\.\w+ import|import rospy\.\w+")
+    allowed = src / "compliant_common" / "src" / "compliant_common" / "rospy_internals.py"
+    found = [f"{path.relative_to(src)}:{n}: {line.strip()}"
+             for path in src.glob("*/src/**/*.py") if path != allowed
+             for n, line in enumerate(path.read_text().splitlines(), 1) if private.search(line)]
+    assert found == [], "\n".join(found)
