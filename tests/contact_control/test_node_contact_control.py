@@ -371,8 +371,10 @@ def test_stale_data_gives_zero_twists_from_the_timer(fresh):
 def test_global_limit_latches_until_reset_and_tare_zeroes(fresh):
     node = fresh
     assert "success: True" in rosservice(readme_command())
+    # Latched on the second wrench in a row over the limit (force_limit_samples): keep sending it.
+    status = latest_status(node, lambda s: s.safety == ContactControlStatus.SAFETY_OVER_LIMIT, "OVER_LIMIT",
+                           keep_publishing=([0, 0, 40.0, 0, 0, 0], "ft_sensor"))
     wait_twist(node, lambda t: t == [0.0] * 6, [0, 0, 40.0, 0, 0, 0], "zero output over the global limit")
-    status = latest_status(node, lambda s: s.safety == ContactControlStatus.SAFETY_OVER_LIMIT, "OVER_LIMIT")
     assert not status.move_active and "reset" in status.message
     assert "success: False" in rosservice(readme_command())  # refused while latched
     status = latest_status(

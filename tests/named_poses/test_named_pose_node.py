@@ -59,18 +59,25 @@ def test_unknown_pose_is_refused_with_the_known_names(stack):
     assert "known: ['home', 'start']" in answer.message
 
 
-def test_refused_while_a_contact_move_runs(stack):
+def _start_a_slow_contact_move() -> None:
+    """A compliant move slowly along -X (contact_control's ~status then says move_active)."""
     import rospy
     from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
-    from compliant_control_msgs.msg import ContactControlStatus
-    from std_srvs.srv import Trigger
 
     req = ConfigureForceControlRequest()
-    req.direction_control_laws.x.type = 3  # compliant move, slowly along -X
+    req.direction_control_laws.x.type = 3  # compliant move
     req.cart_impedance_params.damping.translational.x = 30.0
     req.cart_impedance_params.max_cart_vel.set.linear.x = -0.01
     req.cart_impedance_params.max_path_deviation.translation.x = 0.05
     assert rospy.ServiceProxy("/configure_cartesian_impedance", ConfigureForceControl)(req).success
+
+
+def test_refused_while_a_contact_move_runs(stack):
+    import rospy
+    from compliant_control_msgs.msg import ContactControlStatus
+    from std_srvs.srv import Trigger
+
+    _start_a_slow_contact_move()
     try:
         status = "/contact_control_node/status"
         wait_until(
@@ -88,18 +95,12 @@ def test_a_fresh_named_poses_node_refuses_during_a_contact_move_it_has_not_heard
     for contact_control's status instead of taking silence for "no contact move" (issue #21: the test above
     passed only after others had warmed the connection)."""
     import rospy
-    from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
     from compliant_control_msgs.msg import ContactControlStatus
     from compliant_control_msgs.srv import MoveToNamedPose
     from rospkg import RosPack
     from std_srvs.srv import Trigger
 
-    req = ConfigureForceControlRequest()
-    req.direction_control_laws.x.type = 3  # compliant move, slowly along -X
-    req.cart_impedance_params.damping.translational.x = 30.0
-    req.cart_impedance_params.max_cart_vel.set.linear.x = -0.01
-    req.cart_impedance_params.max_path_deviation.translation.x = 0.05
-    assert rospy.ServiceProxy("/configure_cartesian_impedance", ConfigureForceControl)(req).success
+    _start_a_slow_contact_move()
     params = {"config": RosPack().get_path("ur5_custom") + "/config/named_poses.yaml",
               "trajectory_topic": "/arm_controller/command_unused", "joint_states_topic": "/joint_states"}
     try:
