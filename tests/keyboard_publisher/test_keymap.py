@@ -12,8 +12,8 @@ from keyboard_publisher.teleop import (
     MIN_SPEED_FRACTION,
     PARAMETERS,
     ZERO,
-    SettingsError,
     TeleopSettings,
+    TeleopSettingsError,
     TeleopState,
 )
 
@@ -103,7 +103,7 @@ def test_a_single_tap_moves_for_key_timeout():
 
 
 def test_repeat_timeout_above_key_timeout_is_refused():
-    with pytest.raises(SettingsError, match="repeat_timeout"):
+    with pytest.raises(TeleopSettingsError, match="repeat_timeout"):
         TeleopSettings(key_timeout=0.3, repeat_timeout=0.5)
 
 
@@ -264,7 +264,7 @@ def test_readme_documents_every_parameter_with_its_default():
     ],
 )
 def test_bad_parameters_are_refused_naming_the_key(params, key):
-    with pytest.raises(SettingsError, match=f"'~{key}'") as err:
+    with pytest.raises(TeleopSettingsError, match=f"'~{key}'") as err:
         TeleopSettings.from_params(params)
     assert err.value.key == key
 
@@ -276,7 +276,8 @@ def test_parameters_load_with_defaults_ints_and_warnings():
     assert settings.topic == "jog_arm_server/delta_jog_cmds"
     assert settings.linear_speed == 0.2
     assert warnings == []
-    with pytest.raises(SettingsError, match="~key_timout is not a parameter: did you mean ~key_timeout"):
+    expected = "~key_timout is not a parameter: did you mean ~key_timeout"
+    with pytest.raises(TeleopSettingsError, match=expected):
         TeleopSettings.from_params({"rate": 20, "key_timout": 1.0})
     _, warnings = TeleopSettings.from_params({"key_timeout": 0.3})
     assert any("repeat delay" in w for w in warnings)

@@ -30,7 +30,7 @@ from manipulator_control_gui.form_config import (
     DEFAULT_CONFIG_PATH,
     LAW_FIELDS,
     LAWS,
-    ConfigError,
+    FormConfigError,
     load_config,
 )
 
@@ -303,7 +303,7 @@ def test_bad_config_is_refused_naming_the_key(tmp_path, edit, key):
     edit(data)
     path = tmp_path / "bad.yaml"
     path.write_text(yaml.safe_dump(data, allow_unicode=True))
-    with pytest.raises(ConfigError) as caught:
+    with pytest.raises(FormConfigError) as caught:
         load_config(path)
     assert caught.value.key == key
 

@@ -219,12 +219,12 @@ def test_a_profile_naming_links_the_description_lacks_is_refused(sim, robot):
 
 
 def test_profile_parameters_are_validated():
-    from mujoco_driver.params import DriverSettings, ParamError
+    from mujoco_driver.params import DriverParamError, DriverSettings
 
     settings = DriverSettings.from_params({"scene_config": "s.yaml", "profile": "franka_ros",
                                            "profile_options": {"publish_rate": 100.0}})
     assert settings.profile == "franka_ros" and settings.profile_options == {"publish_rate": 100.0}
-    with pytest.raises(ParamError, match="~profile_options: expected a mapping"):
+    with pytest.raises(DriverParamError, match="~profile_options: expected a mapping"):
         DriverSettings.from_params({"scene_config": "s.yaml", "profile_options": "series: e_series"})
 
 

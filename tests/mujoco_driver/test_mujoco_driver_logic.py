@@ -11,7 +11,7 @@ import yaml
 from mujoco_driver.commands import trajectory_points, velocity_vector
 from mujoco_driver.latency import LatencyProbe
 from mujoco_driver.pacing import Pacer, RtfMeter, TrailingPublication
-from mujoco_driver.params import DriverSettings, ParamError, load_scene, urdf_root_link
+from mujoco_driver.params import DriverParamError, DriverSettings, load_scene, urdf_root_link
 from mujoco_driver.scene import SceneError
 from mujoco_driver.sim import CommandError, Simulation
 
@@ -175,9 +175,9 @@ def test_settings_defaults_and_clock_default_from_use_sim_time():
 
 
 def test_faster_than_real_time_needs_the_clock():
-    with pytest.raises(ParamError, match="real_time_factor"):
+    with pytest.raises(DriverParamError, match="real_time_factor"):
         DriverSettings.from_params({"scene_config": "x", "real_time_factor": 2.0})
-    with pytest.raises(ParamError, match="real_time_factor"):
+    with pytest.raises(DriverParamError, match="real_time_factor"):
         DriverSettings.from_params({"scene_config": "x", "real_time_factor": 0})
     fast = DriverSettings.from_params({"scene_config": "x", "real_time_factor": 0, "publish_clock": True})
     assert fast.real_time_factor == 0.0
@@ -199,14 +199,15 @@ def test_faster_than_real_time_needs_the_clock():
     ({"scene_config": "x", "timestep": 0.02}, "timestep"),
 ])
 def test_bad_parameters_are_refused_naming_the_key(params, key):
-    with pytest.raises(ParamError, match=key):
+    with pytest.raises(DriverParamError, match=key):
         DriverSettings.from_params(params)
 
 
 def test_unknown_keys_refuse_start_up_naming_the_closest_valid_key():
-    with pytest.raises(ParamError, match=r"^~rtf_perod is not a parameter: did you mean ~rtf_period\?$"):
+    with pytest.raises(DriverParamError,
+                       match=r"^~rtf_perod is not a parameter: did you mean ~rtf_period\?$"):
         DriverSettings.from_params({"scene_config": "x", "rtf_perod": 1.0, "viewer": False})
-    with pytest.raises(ParamError, match="~rtf is not a parameter"):
+    with pytest.raises(DriverParamError, match="~rtf is not a parameter"):
         DriverSettings.from_params({"scene_config": "x", "rtf": 1})
     # The node reads ~robot_description itself (emulated_robot.launch sets it).
     settings = DriverSettings.from_params({"scene_config": "x", "robot_description": "<robot/>"})
@@ -218,9 +219,9 @@ def test_urdf_root_link():
             '<joint name="j0" type="fixed"><parent link="world"/><child link="base"/></joint>'
             '<joint name="j1" type="fixed"><parent link="base"/><child link="tip"/></joint></robot>')
     assert urdf_root_link(urdf) == "world"
-    with pytest.raises(ParamError, match="root"):
+    with pytest.raises(DriverParamError, match="root"):
         urdf_root_link('<robot name="r"><link name="a"/><link name="b"/></robot>')
-    with pytest.raises(ParamError, match="XML"):
+    with pytest.raises(DriverParamError, match="XML"):
         urdf_root_link("<robot")
 
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import yaml
 from named_poses.poses import NamedPoses, PoseError, UrdfJoint
-from named_poses.profile import ProfileError, plan_move
+from named_poses.profile import MotionProfileError, plan_move
 
 SRC = pathlib.Path(__file__).resolve().parents[2] / "src"
 ROBOT_PACKAGES = sorted(p for p in SRC.iterdir() if p.name.endswith("_custom"))
@@ -41,7 +41,7 @@ def test_already_there_is_a_zero_length_move():
 @pytest.mark.parametrize("bad", [{"max_velocity": [0.0]}, {"goal": [math.nan]}, {"goal": [1.0, 2.0]}])
 def test_bad_move_input_is_refused(bad):
     args = {"start": [0.0], "goal": [1.0], "max_velocity": [1.0], "max_acceleration": [1.0]} | bad
-    with pytest.raises(ProfileError):
+    with pytest.raises(MotionProfileError):
         plan_move(**args)
 
 

@@ -32,6 +32,7 @@ import math
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from typing import Any, Literal, TypeVar, cast
 
+from compliant_common.errors import StackError
 from compliant_common.keys import unknown_key_message
 
 __all__ = ["Param", "ParamType", "Schema", "SchemaError", "param", "schema_of"]
@@ -47,7 +48,7 @@ _META = "compliant_common.schema.param"
 _T = TypeVar("_T")
 
 
-class SchemaError(ValueError):
+class SchemaError(StackError):
     """A value does not fit its declaration, or a key is not declared.
 
     Attributes:

@@ -12,12 +12,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from compliant_common.errors import StackError
 from compliant_common.schema import SchemaError, param, schema_of
 
 __all__ = ["PARAMETERS", "AxisTuning", "ContactControlSettings", "ParamError", "load_settings"]
 
 
-class ParamError(ValueError):
+class ParamError(StackError):
     """A configuration value is missing its type or range; `key` names it."""
 
     def __init__(self, key: str, message: str) -> None:

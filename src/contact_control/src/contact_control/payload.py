@@ -21,13 +21,14 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from compliant_common.errors import StackError
 
 __all__ = ["PayloadError", "PayloadFit", "fit_payload", "gravity_in_sensor", "read_csv_samples"]
 
 MAX_CONDITION = 1e3  # beyond this the orientations are too alike to separate mass, COM and bias
 
 
-class PayloadError(ValueError):
+class PayloadError(StackError):
     """Too few or too similar samples, or unreadable data."""
 
 

@@ -15,6 +15,8 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
+from compliant_common.errors import StackError
+
 from contact_control.axes import SAFETY_NAN, SAFETY_OK, SAFETY_OVER_LIMIT
 from contact_control.filters import LowPass
 from contact_control.params import ContactControlSettings
@@ -22,7 +24,7 @@ from contact_control.params import ContactControlSettings
 __all__ = ["PreprocessError", "WrenchPreprocessor", "as_rows", "is_finite6"]
 
 
-class PreprocessError(ValueError):
+class PreprocessError(StackError):
     """Bad input to a preprocessing request (tare with invalid data, missing orientation)."""
 
 

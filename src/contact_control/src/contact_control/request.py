@@ -26,6 +26,8 @@ from dataclasses import dataclass
 from types import SimpleNamespace
 from typing import Any
 
+from compliant_common.errors import StackError
+
 from contact_control.axes import (
     AXES,
     EXCEEDED_ACTION_NAMES,
@@ -78,7 +80,7 @@ CODE_NAMES = {
 }
 
 
-class RequestError(ValueError):
+class RequestError(StackError):
     """A refused request: `code` is a CartesianForceCtrlErrorCodes value, `axis` the axis name or ''."""
 
     def __init__(self, code: int, message: str, axis: str = "") -> None:

@@ -28,6 +28,8 @@ import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
+from compliant_common.errors import StackError
+
 __all__ = [
     "DescriptionError",
     "ToolSpec",
@@ -43,7 +45,7 @@ _ERD_SUFFIX = os.path.join("cmeel.prefix", "share", ERD_PACKAGE)
 SHAPES = {"cylinder": 2, "box": 3, "sphere": 1}  # shape -> number of size values
 
 
-class DescriptionError(ValueError):
+class DescriptionError(StackError):
     """Raised for a bad source, an unknown link or an invalid tool specification."""
 
 

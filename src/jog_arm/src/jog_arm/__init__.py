@@ -1,6 +1,7 @@
 """jog_arm: Cartesian jogging of a serial arm (twist in, joint commands out), pure Python core.
 
-The modules here import numpy and Pinocchio only; the ROS adapter is :mod:`jog_arm.node`.
+The modules here import numpy, Pinocchio and compliant_common only; the ROS adapters are
+:mod:`jog_arm.node` and :mod:`jog_arm.ros_io`.
 """
 
 from jog_arm.command_state import CommandResult

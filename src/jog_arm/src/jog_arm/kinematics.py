@@ -22,13 +22,14 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 import pinocchio as pin
+from compliant_common.errors import StackError
 
 from jog_arm.settings import JointLimitOverride
 
 __all__ = ["ArmModel", "KinematicsError"]
 
 
-class KinematicsError(ValueError):
+class KinematicsError(StackError):
     """The URDF cannot be parsed, or a frame or joint named in the configuration is not in it."""
 
 

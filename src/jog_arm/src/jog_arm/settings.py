@@ -11,6 +11,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from typing import Any
 
+from compliant_common.errors import StackError
 from compliant_common.schema import SchemaError, param, schema_of
 
 __all__ = [
@@ -40,13 +41,14 @@ _RENAMED = {
     "coll_check": None,
     "check_collisions": None,
     "contact_guard_exempt": "contact_cmd_in_topic",  # ours before: told contact_control apart by caller id
+    "move_group_name": None,  # the fork's MoveIt group: the chain comes from planning_frame and ee_frame_name
 }
 
 # Keys read by the node only (not part of the motion law), accepted without warning.
 _NODE_ONLY = ("robot_description",)
 
 
-class SettingsError(ValueError):
+class SettingsError(StackError):
     """A parameter is missing, has the wrong type or is out of range; the message names the key."""
 
 
@@ -87,7 +89,6 @@ class JogSettings:
     """
 
     # --- the fork's parameters ---
-    move_group_name: str = param("manipulator", doc="kept for old configs; unused (no MoveIt)")
     scale_linear: float = param(
         0.4, key="scale/linear", unit="m/s", gt=0.0,
         doc="speed of a unitless 1.0 (the fork's value was metres per publish period)",

@@ -13,7 +13,7 @@ from geometry_msgs.msg import TwistStamped
 
 from keyboard_publisher.keymap import Action, key_code, render_help, render_speeds
 from keyboard_publisher.msg import KeyEvent
-from keyboard_publisher.teleop import ZERO, SettingsError, TeleopSettings, TeleopState, Twist6
+from keyboard_publisher.teleop import ZERO, TeleopSettings, TeleopSettingsError, TeleopState, Twist6
 from keyboard_publisher.terminal import KeyReader, RawTerminal, StopSignals, TerminalError
 
 __all__ = ["KeyToTwist", "main"]
@@ -130,7 +130,7 @@ def main(argv: list[str] | None = None) -> int:
     rospy.init_node("key_to_twist", argv=argv, disable_signals=True)  # signals are ours (StopSignals)
     try:
         settings, warnings = TeleopSettings.from_params(rospy.get_param("~", {}))
-    except SettingsError as err:
+    except TeleopSettingsError as err:
         rospy.logfatal(f"key_to_twist: {err}")
         return 2
     for warning in warnings:

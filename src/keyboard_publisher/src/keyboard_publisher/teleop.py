@@ -19,6 +19,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
+from compliant_common.errors import StackError
 from compliant_common.schema import SchemaError, param, schema_of
 
 from keyboard_publisher.keymap import KEYMAP, Action, Binding
@@ -28,8 +29,8 @@ __all__ = [
     "PARAMETERS",
     "ZERO",
     "KeyResult",
-    "SettingsError",
     "TeleopSettings",
+    "TeleopSettingsError",
     "TeleopState",
     "Twist6",
 ]
@@ -44,7 +45,7 @@ MIN_SPEED_FRACTION = 0.01
 # Typical keyboard auto-repeat delay; a shorter key_timeout stops motion before the first repeat arrives.
 TYPICAL_REPEAT_DELAY = 0.5
 
-class SettingsError(ValueError):
+class TeleopSettingsError(StackError):
     """A parameter has a wrong type or range; `key` names it."""
 
     def __init__(self, key: str, message: str) -> None:
@@ -60,7 +61,7 @@ def _speed_range(limit: str) -> str:
 class TeleopSettings:
     """Validated parameters of key_to_twist, each declared once here (name, type, default, unit, range, doc).
 
-    Built directly or by :meth:`from_params`; both check every value (`SettingsError` naming the key).
+    Built directly or by :meth:`from_params`; both check every value (`TeleopSettingsError` naming the key).
     """
 
     topic: str = param(
@@ -101,15 +102,15 @@ class TeleopSettings:
         try:
             PARAMETERS.check(PARAMETERS.values_of(self))
         except SchemaError as err:
-            raise SettingsError(err.key, err.message) from None
+            raise TeleopSettingsError(err.key, err.message) from None
         if self.repeat_timeout > self.key_timeout:
-            raise SettingsError(
+            raise TeleopSettingsError(
                 "repeat_timeout", f"{self.repeat_timeout} s exceeds ~key_timeout ({self.key_timeout} s)"
             )
         for speed, limit in (("linear_speed", "max_linear_speed"), ("angular_speed", "max_angular_speed")):
             value, top = getattr(self, speed), getattr(self, limit)
             if not MIN_SPEED_FRACTION * top <= value <= top:
-                raise SettingsError(
+                raise TeleopSettingsError(
                     speed, f"{value} is outside [{MIN_SPEED_FRACTION * top:g}, {top:g}] (~{limit} = {top:g})"
                 )
 
@@ -123,12 +124,12 @@ class TeleopSettings:
             The settings and warnings (a key_timeout below the usual repeat delay).
 
         Raises:
-            SettingsError: an unknown key (naming the closest valid one), a wrong type or range.
+            TeleopSettingsError: an unknown key (naming the closest valid one), a wrong type or range.
         """
         try:
             values = PARAMETERS.load(params, prefix="~")
         except SchemaError as err:
-            raise SettingsError(err.key, err.message) from None
+            raise TeleopSettingsError(err.key, err.message) from None
         settings = cls(**PARAMETERS.attrs(values))
         warnings: list[str] = []
         if settings.key_timeout <= TYPICAL_REPEAT_DELAY:

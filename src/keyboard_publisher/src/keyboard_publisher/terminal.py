@@ -19,6 +19,8 @@ import termios
 import threading
 from types import FrameType, TracebackType
 
+from compliant_common.errors import StackError
+
 __all__ = ["ESCAPE_WAIT", "KeyParser", "KeyReader", "RawTerminal", "StopSignals", "TerminalError"]
 
 # How long a lone ESC byte waits for the rest of an escape sequence before it counts as the Escape key.
@@ -30,7 +32,7 @@ _CSI_TILDE = {"1": "home", "2": "insert", "3": "delete", "4": "end", "5": "page_
 _CONTROL = {"\r": "enter", "\n": "enter", "\t": "tab", "\x7f": "backspace", "\x08": "backspace"}
 
 
-class TerminalError(RuntimeError):
+class TerminalError(StackError, RuntimeError):
     """The file descriptor is not a terminal, or the terminal went away."""
 
 

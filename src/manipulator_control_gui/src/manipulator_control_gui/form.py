@@ -29,6 +29,7 @@ from collections.abc import Mapping
 from dataclasses import asdict, dataclass, replace
 from typing import Any
 
+from compliant_common.errors import StackError
 from contact_control.request import axis_groups
 
 from manipulator_control_gui.form_config import (
@@ -88,7 +89,7 @@ _RESPONSES: dict[int | None, tuple[str, str]] = {  # None (no code known): the d
 }
 
 
-class FormError(ValueError):
+class FormError(StackError):
     """The form cannot be sent; `axis` and `field` name the culprit ('' when not one field)."""
 
     def __init__(self, message: str, axis: str = "", field: str = "", code: int | None = None) -> None:

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import yaml
+from compliant_common.errors import StackError
 
 __all__ = [
     "AXES",
@@ -20,8 +21,8 @@ __all__ = [
     "FIELDS",
     "LAWS",
     "LAW_FIELDS",
-    "ConfigError",
     "FieldSpec",
+    "FormConfigError",
     "GuiConfig",
     "Preset",
     "is_angular",
@@ -46,7 +47,7 @@ LAW_FIELDS: dict[str, tuple[str, ...]] = {
 DEFAULT_CONFIG_PATH = pathlib.Path(__file__).resolve().parents[2] / "config" / "gui.yaml"
 
 
-class ConfigError(ValueError):
+class FormConfigError(StackError):
     """The GUI configuration is malformed; `key` names the offending entry."""
 
     def __init__(self, key: str, message: str) -> None:
@@ -107,13 +108,13 @@ class GuiConfig:
 
 def _mapping(key: str, value: Any) -> Mapping[str, Any]:
     if not isinstance(value, Mapping):
-        raise ConfigError(key, f"expected a dictionary, got {value!r}")
+        raise FormConfigError(key, f"expected a dictionary, got {value!r}")
     return value
 
 
 def _number(key: str, value: Any) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ConfigError(key, f"expected a finite number, got {value!r}")
+        raise FormConfigError(key, f"expected a finite number, got {value!r}")
     return float(value)
 
 
@@ -121,7 +122,7 @@ def _field_spec(key: str, label: str, raw: Any) -> FieldSpec:
     raw = _mapping(key, raw)
     for name in ("unit", "min", "max", "step", "decimals"):
         if name not in raw:
-            raise ConfigError(f"{key}.{name}", "missing")
+            raise FormConfigError(f"{key}.{name}", "missing")
     spec = FieldSpec(
         label=label,
         unit=str(raw["unit"]),
@@ -131,9 +132,9 @@ def _field_spec(key: str, label: str, raw: Any) -> FieldSpec:
         decimals=int(_number(f"{key}.decimals", raw["decimals"])),
     )
     if spec.minimum >= spec.maximum:
-        raise ConfigError(key, f"min {spec.minimum} must be below max {spec.maximum}")
+        raise FormConfigError(key, f"min {spec.minimum} must be below max {spec.maximum}")
     if spec.step <= 0.0 or spec.decimals < 0:
-        raise ConfigError(key, "step must be > 0 and decimals >= 0")
+        raise FormConfigError(key, "step must be > 0 and decimals >= 0")
     return spec
 
 
@@ -142,7 +143,7 @@ def _check_values(key: str, law: str, values: Mapping[str, Any], fields: Mapping
     extra = set(values) - set(LAW_FIELDS[law])
     missing = set(LAW_FIELDS[law]) - set(values)
     if extra or missing:
-        raise ConfigError(
+        raise FormConfigError(
             key,
             f"law {law} uses exactly {list(LAW_FIELDS[law])}; "
             f"missing {sorted(missing)}, unknown {sorted(extra)}",
@@ -152,7 +153,7 @@ def _check_values(key: str, law: str, values: Mapping[str, Any], fields: Mapping
         number = _number(f"{key}.{name}", value)
         spec = fields[(name, angular)]
         if not spec.minimum <= number <= spec.maximum:
-            raise ConfigError(f"{key}.{name}", f"{number} is outside [{spec.minimum}, {spec.maximum}]")
+            raise FormConfigError(f"{key}.{name}", f"{number} is outside [{spec.minimum}, {spec.maximum}]")
         checked[name] = number
     return checked
 
@@ -172,7 +173,7 @@ def load_config(path: str | pathlib.Path | None = None) -> GuiConfig:
         path: the YAML file; None for the package's `config/gui.yaml`.
 
     Raises:
-        ConfigError: a key is missing, unknown, of the wrong type or out of its range.
+        FormConfigError: a key is missing, unknown, of the wrong type or out of its range.
         OSError: the file cannot be read.
     """
     path = pathlib.Path(path) if path else _default_path()
@@ -186,11 +187,11 @@ def load_config(path: str | pathlib.Path | None = None) -> GuiConfig:
         fields[(name, True)] = _field_spec(f"fields.{name}.angular", label, entry.get("angular"))
     unknown = set(raw_fields) - set(FIELDS)
     if unknown:
-        raise ConfigError("fields", f"unknown fields {sorted(unknown)}; known: {list(FIELDS)}")
+        raise FormConfigError("fields", f"unknown fields {sorted(unknown)}; known: {list(FIELDS)}")
 
     raw_laws = _mapping("laws", data.get("laws"))
     if set(raw_laws) != set(LAWS):
-        raise ConfigError("laws", f"expected exactly {list(LAWS)}, got {sorted(raw_laws)}")
+        raise FormConfigError("laws", f"expected exactly {list(LAWS)}, got {sorted(raw_laws)}")
     law_labels: dict[str, str] = {}
     law_values: dict[tuple[str, bool], dict[str, float]] = {}
     for law in LAWS:
@@ -207,13 +208,14 @@ def load_config(path: str | pathlib.Path | None = None) -> GuiConfig:
         for axis, values in axes.items():
             key = f"presets.{name}.axes.{axis}"
             if axis not in AXES:
-                raise ConfigError(key, f"unknown axis; known: {list(AXES)}")
+                raise FormConfigError(key, f"unknown axis; known: {list(AXES)}")
             values = _mapping(key, values)
             if values.get("law") not in LAWS:
-                raise ConfigError(f"{key}.law", f"expected one of {list(LAWS)}, got {values.get('law')!r}")
+                raise FormConfigError(f"{key}.law",
+                                      f"expected one of {list(LAWS)}, got {values.get('law')!r}")
             for field_name, value in values.items():
                 if field_name != "law" and field_name not in LAW_FIELDS[values["law"]]:
-                    raise ConfigError(f"{key}.{field_name}", f"not a field of law {values['law']}")
+                    raise FormConfigError(f"{key}.{field_name}", f"not a field of law {values['law']}")
                 if field_name != "law":
                     _number(f"{key}.{field_name}", value)
         presets[name] = Preset(name, str(entry.get("label", name)), axes)

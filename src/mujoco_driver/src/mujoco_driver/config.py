@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import yaml
+from compliant_common.errors import StackError
 
 __all__ = [
     "Box",
@@ -35,7 +36,7 @@ __all__ = [
 INTEGRATORS = ("implicitfast", "implicit")
 
 
-class ConfigError(ValueError):
+class ConfigError(StackError):
     """Raised for a missing, unknown or out-of-range scene setting; the message names the key."""
 
 

@@ -19,6 +19,8 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from compliant_common.errors import StackError
+
 __all__ = ["BEST_EFFORT", "STRICT", "ControllerError", "ControllerManager", "ControllerSpec", "SwitchResult"]
 
 BEST_EFFORT = 1  # controller_manager_msgs/SwitchController constants
@@ -26,7 +28,7 @@ STRICT = 2
 _STATES = ("running", "stopped", "initialized")
 
 
-class ControllerError(ValueError):
+class ControllerError(StackError):
     """A controller list in a profile is invalid (the message names the controller and the key)."""
 
 

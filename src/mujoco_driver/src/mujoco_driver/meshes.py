@@ -33,6 +33,7 @@ from dataclasses import dataclass
 from typing import cast
 
 import numpy as np
+from compliant_common.errors import StackError
 
 __all__ = [
     "CACHE_ENV",
@@ -58,7 +59,7 @@ KEPT, CONVERTED, BOX, CAPSULE, FROM_VISUAL, NONE = (
 )
 
 
-class MeshError(ValueError):
+class MeshError(StackError):
     """A mesh cannot be converted; `bounds` holds its (2, 3) axis-aligned bounds if they could be read."""
 
     def __init__(self, message: str, bounds: np.ndarray | None = None) -> None:

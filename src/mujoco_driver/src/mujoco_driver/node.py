@@ -36,7 +36,7 @@ from mujoco_driver.config import ConfigError, SceneConfig
 from mujoco_driver.emulated_driver import EmulatedDriver, resolve_profile
 from mujoco_driver.latency import LatencyProbe
 from mujoco_driver.pacing import Pacer, RtfMeter, TrailingPublication
-from mujoco_driver.params import DriverSettings, ParamError, load_scene, urdf_root_link
+from mujoco_driver.params import DriverParamError, DriverSettings, load_scene, urdf_root_link
 from mujoco_driver.profiles import DriverProfile, ProfileError
 from mujoco_driver.scene import SceneError
 from mujoco_driver.sim import CommandError, Simulation
@@ -463,11 +463,11 @@ def main(argv: list[str] | None = None) -> int:
         # robot_description, which the user's own launch file may load, as on a real cell.
         key = "~robot_description" if rospy.has_param("~robot_description") else "robot_description"
         if not rospy.has_param(key):
-            raise ParamError(f"{rospy.resolve_name('robot_description')} is not set (the URDF)")
+            raise DriverParamError(f"{rospy.resolve_name('robot_description')} is not set (the URDF)")
         urdf = rospy.get_param(key)
         settings, profile = resolve_profile(settings)  # with ~profile, the real driver's topic names
         node = MujocoDriverNode(settings, urdf, load_scene(settings), profile)
-    except (ParamError, ConfigError, SceneError, ProfileError) as exc:
+    except (DriverParamError, ConfigError, SceneError, ProfileError) as exc:
         rospy.logfatal("mujoco_driver: %s", exc)
         rospy.signal_shutdown("bad configuration")
         return 1

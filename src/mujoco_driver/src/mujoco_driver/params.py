@@ -12,14 +12,15 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from compliant_common.errors import StackError
 from compliant_common.schema import Param, SchemaError, param, schema_of
 
 from mujoco_driver.config import PerJoint, SceneConfig, load_scene_config
 
-__all__ = ["PARAMETERS", "DriverSettings", "ParamError", "load_scene", "urdf_root_link"]
+__all__ = ["PARAMETERS", "DriverParamError", "DriverSettings", "load_scene", "urdf_root_link"]
 
 
-class ParamError(ValueError):
+class DriverParamError(StackError):
     """A driver parameter is missing, of the wrong type or out of range; the message names it."""
 
 
@@ -125,12 +126,12 @@ class DriverSettings:
             use_sim_time: The value of ``/use_sim_time``: the default of ``publish_clock``.
 
         Raises:
-            ParamError: Naming the first bad key, or an unknown key and the closest valid one.
+            DriverParamError: Naming the first bad key, or an unknown key and the closest valid one.
         """
         try:
             values = PARAMETERS.attrs(PARAMETERS.load(params, prefix="~"))
         except SchemaError as err:
-            raise ParamError(err.named("~")) from None
+            raise DriverParamError(err.named("~")) from None
         values.setdefault("publish_clock", bool(use_sim_time))
         settings = cls(**values)
         settings.validate()
@@ -140,19 +141,20 @@ class DriverSettings:
         """Check the relations between parameters (each one's own range is in its declaration).
 
         Raises:
-            ParamError: Naming the first bad key.
+            DriverParamError: Naming the first bad key.
         """
         if not self.scene_config and self.scene is None:
-            raise ParamError("~scene_config: missing (path of the scene YAML), and no ~scene mapping either")
+            raise DriverParamError(
+                "~scene_config: missing (path of the scene YAML), and no ~scene mapping either")
         if self.scene_config and self.scene is not None:
-            raise ParamError("~scene_config and ~scene are both set: give one")
+            raise DriverParamError("~scene_config and ~scene are both set: give one")
         if not self.publish_clock and (self.real_time_factor > 1.0 or self.real_time_factor == 0.0):
-            raise ParamError(
+            raise DriverParamError(
                 f"~real_time_factor: {self.real_time_factor} runs faster than the wall clock, which needs "
                 "simulated time: set ~publish_clock (or /use_sim_time) true"
             )
         if self.start_pose is not None and not isinstance(self.start_pose, Mapping | list | tuple):
-            raise ParamError(f"~start_pose: expected a list (URDF joint order) or a mapping, got "
+            raise DriverParamError(f"~start_pose: expected a list (URDF joint order) or a mapping, got "
                              f"{self.start_pose!r}")
 
     def eef_pose_every(self, dt: float) -> int:
@@ -176,16 +178,16 @@ def urdf_root_link(urdf_xml: str) -> str:
     """Name of the URDF's root link (the one no joint has as its child).
 
     Raises:
-        ParamError: If the URDF has no single root link.
+        DriverParamError: If the URDF has no single root link.
     """
     try:
         robot = ET.fromstring(urdf_xml)
     except ET.ParseError as exc:
-        raise ParamError(f"robot_description: not valid XML: {exc}") from exc
+        raise DriverParamError(f"robot_description: not valid XML: {exc}") from exc
     children = {c.get("link") for joint in robot.iter("joint") for c in joint.findall("child")}
     roots = [link.get("name") for link in robot.findall("link") if link.get("name") not in children]
     if len(roots) != 1:
-        raise ParamError(f"robot_description: expected one root link, found {roots}")
+        raise DriverParamError(f"robot_description: expected one root link, found {roots}")
     return str(roots[0])
 
 

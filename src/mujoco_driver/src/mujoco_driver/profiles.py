@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import yaml
+from compliant_common.errors import StackError
 
 from mujoco_driver.controllers import ControllerError, ControllerSpec
 
@@ -38,7 +39,7 @@ PROFILE_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.pa
 _MODELS = ("sensor", "payload_compensated", "external_estimate", "current_estimate")
 
 
-class ProfileError(ValueError):
+class ProfileError(StackError):
     """A profile cannot be found or is invalid; the message names the file and the key."""
 
 

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
+from compliant_common.errors import StackError
 
 from mujoco_driver.config import SceneConfig
 from mujoco_driver.meshes import LinkGeometry, prepare_collision
@@ -49,7 +50,7 @@ _INTEGRATORS = {
 }
 
 
-class SceneError(ValueError):
+class SceneError(StackError):
     """Raised when the URDF and the scene settings cannot make a valid model."""
 
 

@@ -59,6 +59,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from compliant_common.errors import StackError
 
 __all__ = [
     "AXES",
@@ -103,7 +104,7 @@ REST_RULE = (f"moving std over max({REST_WINDOW_S:g} s, {REST_WINDOW_MIN} sample
              f"first and the last, mean force within {HOLD_FACTOR:g} x that percentile of either")
 
 
-class SensorFitError(ValueError):
+class SensorFitError(StackError):
     """The recording cannot be read or fitted; the message says why in one line."""
 
 

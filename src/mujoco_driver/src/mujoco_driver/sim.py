@@ -28,6 +28,7 @@ from typing import Any, NamedTuple
 
 import mujoco
 import numpy as np
+from compliant_common.errors import StackError
 
 from mujoco_driver.config import SceneConfig
 from mujoco_driver.scene import SceneModel, build_scene
@@ -40,7 +41,7 @@ MODE_POSITION, MODE_VELOCITY, MODE_TRAJECTORY = "position", "velocity", "traject
 TRACKING_GAIN = 30.0
 
 
-class CommandError(ValueError):
+class CommandError(StackError):
     """Raised for a malformed command (wrong length, NaN, unknown joint, bad timing); state is unchanged."""
 
 

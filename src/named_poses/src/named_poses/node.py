@@ -25,7 +25,7 @@ from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from named_poses.params import FILE_KEYS, load_settings
 from named_poses.poses import NamedPoses, PoseError, urdf_joints
-from named_poses.profile import ProfileError, plan_move
+from named_poses.profile import MotionProfileError, plan_move
 from named_poses.switching import Controller, Switch, SwitchError, controller_of, plan_switch
 
 __all__ = ["NamedPoseServer", "main"]
@@ -173,7 +173,7 @@ class NamedPoseServer:
             move = plan_move(
                 current, goal, self.poses.max_velocity * scale, self.poses.max_acceleration * scale
             )
-        except (PoseError, ProfileError) as exc:
+        except (PoseError, MotionProfileError) as exc:
             return self._refuse(str(exc))
         msg = JointTrajectory()
         msg.joint_names = list(self.poses.joints)

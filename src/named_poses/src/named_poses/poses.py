@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from compliant_common.errors import StackError
 
 from named_poses.params import FILE_KEYS, NamedPoseSettings
 
@@ -24,7 +25,7 @@ __all__ = ["NamedPoses", "PoseError", "UrdfJoint", "urdf_joints"]
 _DEFAULTS = NamedPoseSettings()
 
 
-class PoseError(ValueError):
+class PoseError(StackError):
     """A named pose or limit that cannot be used; the message names the key."""
 
 

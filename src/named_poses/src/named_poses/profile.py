@@ -13,11 +13,12 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from compliant_common.errors import StackError
 
-__all__ = ["JointMove", "ProfileError", "plan_move"]
+__all__ = ["JointMove", "MotionProfileError", "plan_move"]
 
 
-class ProfileError(ValueError):
+class MotionProfileError(StackError):
     """Limits or positions that give no move (non-positive limits, NaN, mismatched lengths)."""
 
 
@@ -67,22 +68,23 @@ def plan_move(
         The sampled move; a single sample at t = 0 if already there.
 
     Raises:
-        ProfileError: Mismatched lengths, non-finite values or non-positive limits.
+        MotionProfileError: Mismatched lengths, non-finite values or non-positive limits.
     """
     q0, q1 = np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
     vmax, amax = np.asarray(max_velocity, dtype=float), np.asarray(max_acceleration, dtype=float)
     if not (q0.shape == q1.shape == vmax.shape == amax.shape) or q0.ndim != 1:
-        raise ProfileError(
+        raise MotionProfileError(
             "start, goal and limits need one value per joint: "
             f"{q0.shape}, {q1.shape}, {vmax.shape}, {amax.shape}"
         )
     for label, values in (("start", q0), ("goal", q1), ("max_velocity", vmax), ("max_acceleration", amax)):
         if not np.all(np.isfinite(values)):
-            raise ProfileError(f"{label} is not finite: {values.tolist()}")
+            raise MotionProfileError(f"{label} is not finite: {values.tolist()}")
     if np.any(vmax <= 0) or np.any(amax <= 0):
-        raise ProfileError(f"limits must be positive: velocity {vmax.tolist()}, acceleration {amax.tolist()}")
+        raise MotionProfileError(
+            f"limits must be positive: velocity {vmax.tolist()}, acceleration {amax.tolist()}")
     if not sample_period > 0:
-        raise ProfileError(f"sample_period must be positive, got {sample_period}")
+        raise MotionProfileError(f"sample_period must be positive, got {sample_period}")
     delta = q1 - q0
     moving = np.abs(delta) > 1e-12
     if not np.any(moving):

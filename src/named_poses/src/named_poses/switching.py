@@ -11,10 +11,12 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
+from compliant_common.errors import StackError
+
 __all__ = ["Controller", "Switch", "SwitchError", "controller_of", "plan_switch"]
 
 
-class SwitchError(Exception):
+class SwitchError(StackError):
     """The trajectory controller cannot be switched on (unknown, or nothing to switch with)."""
 
 

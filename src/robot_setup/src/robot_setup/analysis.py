@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
+from compliant_common.errors import StackError
 from jog_arm.kinematics import ArmModel
 from jog_arm.settings import JogSettings
 
@@ -49,7 +50,7 @@ MIN_MARGIN = 0.15
 MIN_JOINT_HEIGHT = 0.05
 
 
-class StartPoseError(RuntimeError):
+class StartPoseError(StackError, RuntimeError):
     """No start pose satisfies the demands (the message says which were tried and why they failed)."""
 
 

@@ -31,6 +31,7 @@ import math
 from collections.abc import Collection
 from dataclasses import dataclass
 
+from compliant_common.errors import StackError
 from mujoco_driver.profiles import DriverProfile, ProfileError, known_profiles, load_profile, profile_path
 
 __all__ = ["GENERIC", "GENERIC_TRAJECTORY_TOPIC", "DriverError", "DriverInterface", "driver_interface"]
@@ -41,7 +42,7 @@ STATE_TIMEOUT_PERIODS = 5.0
 MIN_STATE_TIMEOUT = 0.1
 
 
-class DriverError(ValueError):
+class DriverError(StackError):
     """An unknown or unusable driver profile (the message names it and the known profiles)."""
 
 

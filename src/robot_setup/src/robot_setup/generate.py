@@ -31,6 +31,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from compliant_common.errors import StackError
 from control_stack.description import (
     ERD_PACKAGE,
     DescriptionError,
@@ -69,7 +70,7 @@ KP_PER_NM, KP_MAX, KP_MIN = 120.0, 20000.0, 1000.0
 KV_RATIO = 0.02  # kv = kp * this [s]
 
 
-class GeneratorError(ValueError):
+class GeneratorError(StackError):
     """Bad input (unknown link, missing URDF, bad name or mass), named."""
 
 

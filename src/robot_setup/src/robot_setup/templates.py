@@ -248,7 +248,6 @@ singularity_length_scale: 0.4       # [m] jog_arm's default, stated because the 
     files["config/jog_arm.yaml"] = f"""# jog_arm_server settings for the simulated {name}, loaded on top of jog_arm's config/jog_arm.yaml;
 # {generated}. Units: m, rad, s.
 
-move_group_name: manipulator        # informational
 ee_frame_name: tool_tip             # tool centre point from make_description
 planning_frame: {plan.base}
 cmd_frame: {plan.base}
@@ -273,7 +272,6 @@ low_pass_filter_coeff: 2.0
         files["config/jog_arm_hardware.yaml"] = f"""# jog_arm_server settings for a real {name} (written by make robot for a generic driver, run against
 # mujoco_driver's emulated_robot.launch without a profile; set the topics of your driver). Loaded on top of jog_arm's config/jog_arm.yaml by launch/hardware.launch. Units: m, rad, s.
 
-move_group_name: manipulator
 ee_frame_name: tool_tip
 planning_frame: {plan.base}
 cmd_frame: {plan.base}
@@ -522,7 +520,6 @@ def _jog_arm_hardware(plan: Plan, command: str, thresholds: str) -> str:
             f"{_switch_words(d)}."
         )
     return f"""{header}
-move_group_name: manipulator
 ee_frame_name: tool_tip
 planning_frame: {plan.base}
 cmd_frame: {plan.base}

@@ -18,6 +18,7 @@ from dataclasses import dataclass, fields, replace
 from typing import Any
 
 import yaml
+from compliant_common.errors import StackError
 
 __all__ = [
     "DEMOS_FILE",
@@ -47,7 +48,7 @@ SURFACE_DIRECTION = -1  # along X: toward the base
 PASSING_CLEARANCE = 0.02
 
 
-class DemoConfigError(ValueError):
+class DemoConfigError(StackError):
     """A demos.yaml (or the scene's obstacle) that cannot be used; the message names the key."""
 
 
