@@ -36,6 +36,7 @@ __all__ = [
     "build_description",
     "find_example_robot_data",
     "main",
+    "parse_robot",
     "resolve_package_uri",
 ]
 
@@ -312,6 +313,21 @@ def read_source(source: str, erd_dir: str | None = None) -> str:
         return handle.read()
 
 
+def parse_robot(urdf_xml: str) -> ET.Element:
+    """The <robot> element of a URDF text.
+
+    Raises:
+        DescriptionError: Not XML, or another root element.
+    """
+    try:
+        robot = ET.fromstring(urdf_xml)
+    except ET.ParseError as exc:
+        raise DescriptionError(f"URDF is not valid XML: {exc}") from exc
+    if robot.tag != "robot":
+        raise DescriptionError(f"root element is <{robot.tag}>, expected <robot>")
+    return robot
+
+
 def build_description(
     urdf_xml: str,
     tool: ToolSpec | None = None,
@@ -334,12 +350,7 @@ def build_description(
     Raises:
         DescriptionError: On malformed XML, unknown links, clashing names or a bad tool.
     """
-    try:
-        robot = ET.fromstring(urdf_xml)
-    except ET.ParseError as exc:
-        raise DescriptionError(f"URDF is not valid XML: {exc}") from exc
-    if robot.tag != "robot":
-        raise DescriptionError(f"root element is <{robot.tag}>, expected <robot>")
+    robot = parse_robot(urdf_xml)
     _remove_subtrees(robot, remove_links)
     meshes = robot.iter("mesh")
     for mesh in meshes:

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 from compliant_common.errors import StackError
+from control_stack.description import DescriptionError, parse_robot
 
 from mujoco_driver.config import SceneConfig
 from mujoco_driver.meshes import LinkGeometry, prepare_collision
@@ -80,12 +81,9 @@ def rpy_to_quat(rpy: Sequence[float]) -> np.ndarray:
 
 def _parse(urdf_xml: str) -> ET.Element:
     try:
-        robot = ET.fromstring(urdf_xml)
-    except ET.ParseError as exc:
-        raise SceneError(f"URDF is not valid XML: {exc}") from exc
-    if robot.tag != "robot":
-        raise SceneError(f"root element is <{robot.tag}>, expected <robot>")
-    return robot
+        return parse_robot(urdf_xml)
+    except DescriptionError as exc:
+        raise SceneError(str(exc)) from None
 
 
 def urdf_joints(urdf_xml: str) -> dict[str, UrdfJoint]:
