@@ -574,8 +574,11 @@ class ContactControl:
                 )
                 self._measured_floor(zeroing)
             self._tare_pending = False
-            if self._drift is not None and self._drift.drift is not None:  # measured: it is zero again
-                self._drift.rezeroed()
+            if self._drift is not None:  # a new window from the new zero; a drift measured before is 0 now
+                if self._drift.drift is None:
+                    self._drift.restart()
+                else:
+                    self._drift.rezeroed()
         code, w = self.preprocessor.process(wrench, T_control_sensor, R_world_sensor)
         if code != SAFETY_OK:
             if code == SAFETY_NAN:
@@ -658,9 +661,8 @@ class ContactControl:
         floor = NoiseFloor.measure(zeroing.std(), rate, n, cutoff, zeroing.lag1())
         self._floor_noise = floor
         self._watch_floor_update()
-        if self._drift is not None:  # steady at rest now means within this noise
+        if self._drift is not None:  # steady at rest now means within this noise (from the next window)
             self._drift.noise = floor.std
-            self._drift.restart()
         note = floor.describe()
         k = s.noise_deadband_sigmas
         if k > 0.0:

@@ -117,8 +117,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             if any(s.name == name for s in scenarios):
                 print(f"[CANNOT] {name}: this arm cannot do it as configured: {reason}", flush=True)
     floor = runner.noise_floor()
-    sigmas = runner.noise_limit_sigmas()
-    global_force = runner.global_max_force()
+    sigmas = runner.contact_setting("noise_limit_sigmas")
+    global_force = runner.contact_setting("global_max_force")
     for scenario in scenarios:
         if scenario.name in cannot:
             continue

@@ -212,7 +212,7 @@ class DemoRunner:
         x, y, z, w = q.x, q.y, q.z, q.w
         # The wrench is read as contact_control reads it: its ft_*_direction sign flips first (a driver that
         # reports the wrench the robot exerts has all three -1 in its robot package's hardware YAML).
-        signs = [float(rospy.get_param(f"{self.names.contact_control}/ft_{a}_direction", 1)) for a in "xyz"]
+        signs = [self.contact_setting(f"ft_{a}_direction") for a in "xyz"]
         self._sensor_rotation = np.array(
             [
                 [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
@@ -327,15 +327,10 @@ class DemoRunner:
         if not response.success:
             raise RuntimeError(f"{scenario.name}: contact_control refused the request (see its ~status)")
 
-    def noise_limit_sigmas(self) -> float:
-        """contact_control's noise_limit_sigmas (its default if unset)."""
-        return float(rospy.get_param(f"{self.names.contact_control}/noise_limit_sigmas",
-                                     ContactControlSettings.noise_limit_sigmas))
-
-    def global_max_force(self) -> float:
-        """contact_control's global_max_force [N] (its default if unset)."""
-        return float(rospy.get_param(f"{self.names.contact_control}/global_max_force",
-                                     ContactControlSettings.global_max_force))
+    def contact_setting(self, name: str) -> float:
+        """contact_control's parameter `name` as the node reads it (its default if unset)."""
+        default = getattr(ContactControlSettings, name)
+        return float(rospy.get_param(f"{self.names.contact_control}/{name}", default))
 
     def noise_floor(self, timeout: float = 10.0) -> NoiseFloor | None:
         """contact_control's noise floor as its ~status reports it (measured while zeroing); None when it
