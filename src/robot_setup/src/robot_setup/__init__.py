@@ -1,2 +1,2 @@
 """Adding an arm: reach analysis and start pose (`analysis`, `collisions`), the robot-package generator
-(`generate`, `templates`), the checker (`check`)."""
+(`generate`, `plan`, `templates`), the checker (`check`)."""

@@ -24,11 +24,9 @@ from __future__ import annotations
 import argparse
 import math
 import os
-import re
 import sys
 import xml.etree.ElementTree as ET
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from compliant_common.errors import StackError
@@ -43,19 +41,23 @@ from control_stack.description import (
 from jog_arm.kinematics import ArmModel
 from thesis_demos.geometry import SURFACE_TRAVEL, DemoGeometry, demo_motions
 
+from robot_setup import templates
 from robot_setup.analysis import (
     LENGTH_SCALE,
-    PoseReport,
     StartPoseError,
     analyse_pose,
     estimate_reach,
     find_start_pose,
     lowest_joint,
+    tip_path,
 )
 from robot_setup.collisions import CollisionChecker
-from robot_setup.driver import DriverError, DriverInterface, driver_interface
+from robot_setup.driver import DriverError, driver_interface
+from robot_setup.plan import Plan, RobotSpec, command_line, recorded_command
 from robot_setup.sensor_limits import contact_force_for
 
+# Plan, RobotSpec, command_line and recorded_command live in robot_setup.plan (the templates read them too);
+# named here as well, where the tests and tests/robot_packages import them.
 __all__ = ["GeneratorError", "Plan", "RobotSpec", "command_line", "main", "plan_robot", "recorded_command",
            "render", "write_package"]
 
@@ -72,78 +74,6 @@ KV_RATIO = 0.02  # kv = kp * this [s]
 
 class GeneratorError(StackError):
     """Bad input (unknown link, missing URDF, bad name or mass), named."""
-
-
-@dataclass(frozen=True)
-class RobotSpec:
-    """What the user gives: `make robot NAME=... URDF=... TIP=... [BASE=...] [TOOL_MASS=...] [DRIVER=...]`."""
-
-    name: str
-    urdf: str  # a path, or a path relative to example-robot-data's robots/
-    tip: str  # the flange link the sensor and tool go on
-    base: str = ""  # the base frame; empty: the URDF root (or its only fixed child, if the root is a 'world')
-    tool_mass: float = 1.0  # [kg]
-    driver: str = ""  # a mujoco_driver profile name or YAML path the hardware files are for; empty: generic
-
-
-def command_line(spec: RobotSpec, with_driver: bool = True) -> str:
-    """The `make robot` command of `spec` (what the package records; `recorded_command` reads it back).
-
-    Args:
-        spec: The command's arguments.
-        with_driver: Include `DRIVER=` (the simulation's files leave it out: they are the same for any
-            driver).
-    """
-
-    def num(v: float) -> str:
-        return f"{v:.10g}"
-
-    return (
-        f"make robot NAME={spec.name} URDF={spec.urdf} TIP={spec.tip}"
-        + (f" BASE={spec.base}" if spec.base else "")
-        + f" TOOL_MASS={num(spec.tool_mass)}"
-        + (f" DRIVER={spec.driver}" if with_driver and spec.driver else "")
-    )
-
-
-_COMMAND = re.compile(
-    r"`make robot NAME=(\S+) URDF=(\S+) TIP=(\S+)(?: BASE=(\S+))? TOOL_MASS=(\S+?)(?: DRIVER=(\S+))?`"
-)
-
-
-def recorded_command(readme: str) -> RobotSpec | None:
-    """The `make robot` command a generated package's README records (None: not generated)."""
-    match = _COMMAND.search(readme)
-    if not match:
-        return None
-    name, urdf, tip, base, mass, driver = match.groups()
-    return RobotSpec(name, urdf, tip, base or "", float(mass), driver or "")
-
-
-@dataclass(frozen=True)
-class Plan:
-    """Everything the package's files say, measured."""
-
-    spec: RobotSpec
-    source: str  # make_description's --source
-    removed: tuple[str, ...]  # subtrees below the flange (a gripper the tool replaces)
-    base: str
-    urdf_xml: str
-    joints: tuple[str, ...]
-    reach: float
-    geometry: DemoGeometry
-    gap: float
-    obstacle_size: tuple[float, float, float]
-    obstacle_position: tuple[float, float, float]
-    start: PoseReport
-    home: np.ndarray
-    threshold: float
-    hard_stop: float
-    kp: tuple[float, ...]
-    kv: tuple[float, ...]
-    armature: float
-    efforts: tuple[float, ...]
-    driver: DriverInterface  # the hardware files' driver (generic, or from the DRIVER profile)
 
 
 def _source(urdf: str) -> tuple[str, str]:
@@ -194,7 +124,7 @@ def _round(value: float, step: float) -> float:
     return round(round(value / step) * step, 6)
 
 
-def plan_robot(spec: RobotSpec, log=print) -> Plan:
+def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
     """Measure the arm and decide every number of its package (see the module docstring).
 
     Raises:
@@ -270,8 +200,6 @@ def plan_robot(spec: RobotSpec, log=print) -> Plan:
     obstacle_position = (_round(tip[0], 0.001), _round(tip[1], 0.001), _round(top / 2.0, 0.0005))
     # Home: the start pose lifted 0.1 m (scaled), clear of the obstacle.
     lift = analyse_pose(arm, q0, {"home": [(0.0, 0.0, 0.1 * scale)]})
-    from robot_setup.analysis import tip_path
-
     path, ok = tip_path(arm, q0, (0.0, 0.0, 0.1 * scale))
     home = np.round(path[-1], 4) if ok and lift.reachable else q0
     efforts = []
@@ -323,15 +251,8 @@ def analysis_lines(plan: Plan, arm: ArmModel | None = None) -> list[str]:
     return lines
 
 
-def _yaml_joints(values: Sequence[float], joints: Sequence[str], indent: int = 2, fmt: str = "{:.4f}") -> str:
-    pad = " " * indent
-    return "\n".join(f"{pad}{j}: {fmt.format(v)}" for j, v in zip(joints, values, strict=True))
-
-
 def render(plan: Plan) -> dict[str, str]:
     """The package's files: relative path -> text."""
-    from robot_setup import templates
-
     return templates.render(plan, analysis_lines(plan))
 
 

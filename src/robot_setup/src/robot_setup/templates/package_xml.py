@@ -1,0 +1,35 @@
+"""package.xml: the exec dependencies of the launch files."""
+
+from __future__ import annotations
+
+from robot_setup.plan import Plan
+from robot_setup.templates.text import generated_by
+
+__all__ = ["package_xml"]
+
+
+def package_xml(plan: Plan) -> str:
+    name = plan.spec.name
+    return f"""<?xml version="1.0"?>
+<package format="2">
+  <name>{name}_custom</name>
+  <version>1.0.0</version>
+  <description>
+    {name} configuration for the compliant-control stack ({generated_by(plan.spec).replace('`', '')}): robot
+    description arguments (stock URDF + wrist F/T sensor frame + tool), the MuJoCo scene, contact_control,
+    jog_arm and named-pose settings, the demonstrations' geometry, and launch files.
+  </description>
+  <maintainer email="dev@example.com">compliant-control developers</maintainer>
+  <license>BSD</license>
+
+  <buildtool_depend>catkin</buildtool_depend>
+  <exec_depend>contact_control</exec_depend>
+  <exec_depend>control_stack</exec_depend>
+  <exec_depend>jog_arm</exec_depend>
+  <exec_depend>keyboard_publisher</exec_depend>
+  <exec_depend>mujoco_driver</exec_depend>
+  <exec_depend>named_poses</exec_depend>
+  <exec_depend>robot_state_publisher</exec_depend>
+  <!-- The URDF and meshes stay where they are ({plan.source}); nothing is copied here. -->
+</package>
+"""

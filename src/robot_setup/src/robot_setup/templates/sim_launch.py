@@ -1,0 +1,58 @@
+# ruff: noqa: E501  (the template is the file's text: launch-file docs keep their long lines)
+"""launch/sim.launch: the simulated stack (mujoco_driver's sim_stack.launch on this package's config) and named_poses."""
+
+from __future__ import annotations
+
+from robot_setup.driver import GENERIC_TRAJECTORY_TOPIC
+from robot_setup.plan import Plan
+from robot_setup.templates.text import generated_by
+
+__all__ = ["sim_launch"]
+
+
+def sim_launch(plan: Plan) -> str:
+    name = plan.spec.name
+    pkg = f"{name}_custom"
+    generated = generated_by(plan.spec, with_driver=False)
+    return f"""<?xml version="1.0"?>
+<!--
+  Simulated {name} compliant-control stack ({generated.replace('`', '')}): robot_description,
+  robot_state_publisher, the MuJoCo driver (headless; viewer:=true for a window), jog_arm_server and
+  contact_control_node, and named_poses. Everything generic is in mujoco_driver/launch/sim_stack.launch.
+-->
+<launch>
+  <arg name="viewer" default="false" doc="open MuJoCo's viewer (only if a DISPLAY exists)"/>
+  <arg name="start_pose" default="" doc="override of config/sim.yaml's start pose: '[q1, ..., qn]' [rad], URDF joint order"/>
+  <arg name="real_time_factor" default="1.0" doc="simulated s per wall s; > 1 or 0 (as fast as possible) need sim_time:=true"/>
+  <arg name="sim_time" default="false" doc="simulated time: the driver publishes /clock, /use_sim_time true"/>
+  <arg name="with_jog_arm" default="true" doc="start jog_arm_server"/>
+  <arg name="with_contact_control" default="true" doc="start contact_control_node"/>
+  <arg name="single_process" default="true" doc="contact_control and jog_arm in one process (control_stack_node), one hop less"/>
+  <arg name="publish_synchronously" default="true" doc="the driver writes subscribers' sockets in its loop"/>
+  <arg name="output" default="screen" doc="screen or log"/>
+
+  <include file="$(find mujoco_driver)/launch/sim_stack.launch">
+    <arg name="description_args" value="$(find {pkg})/config/description.args"/>
+    <arg name="scene_config" value="$(find {pkg})/config/sim.yaml"/>
+    <arg name="jog_arm_config" value="$(find {pkg})/config/jog_arm.yaml"/>
+    <arg name="contact_control_config" value="$(find {pkg})/config/contact_control.yaml"/>
+    <arg name="trajectory_command_topic" value="{GENERIC_TRAJECTORY_TOPIC}"/>
+    <arg name="viewer" value="$(arg viewer)"/>
+    <arg name="start_pose" value="$(arg start_pose)"/>
+    <arg name="real_time_factor" value="$(arg real_time_factor)"/>
+    <arg name="sim_time" value="$(arg sim_time)"/>
+    <arg name="with_jog_arm" value="$(arg with_jog_arm)"/>
+    <arg name="with_contact_control" value="$(arg with_contact_control)"/>
+    <arg name="single_process" value="$(arg single_process)"/>
+    <arg name="publish_synchronously" value="$(arg publish_synchronously)"/>
+    <arg name="output" value="$(arg output)"/>
+  </include>
+
+  <!-- Named poses (config/named_poses.yaml): /named_poses/move_to through the driver's trajectory input. -->
+  <include file="$(find named_poses)/launch/named_poses.launch">
+    <arg name="config" value="$(find {pkg})/config/named_poses.yaml"/>
+    <arg name="trajectory_topic" value="{GENERIC_TRAJECTORY_TOPIC}"/>
+    <arg name="output" value="$(arg output)"/>
+  </include>
+</launch>
+"""
