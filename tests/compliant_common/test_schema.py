@@ -53,6 +53,7 @@ def test_load_converts_what_is_given_and_leaves_the_rest_to_the_defaults() -> No
     assert isinstance(values["rate"], float) and isinstance(values["flip"], int)
     settings = Demo(**SCHEMA.attrs(values))
     assert settings.scale_linear == 1.0 and settings.topic == "wrench"
+    assert SCHEMA.build(Demo, values) == settings  # the typed spelling of the line above
     assert SCHEMA.values_of(settings)["scale/linear"] == 1.0
     assert SCHEMA.load({"limit": None})["limit"] is None
 

@@ -5,14 +5,18 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable
-from typing import Any
+from typing import TypeAlias
 
 import rospy
+from rospy.timer import TimerEvent
 
 from compliant_common.clock import ClockJump, ClockWatch
 from compliant_common.rospy_internals import is_wallclock
 
-__all__ = ["JumpAwareClock", "MonotonicTimer", "timer"]
+__all__ = ["JumpAwareClock", "MonotonicTimer", "TimerCallback", "timer"]
+
+#: A timer's callback: gets rospy's `TimerEvent`, or None from a `MonotonicTimer`.
+TimerCallback: TypeAlias = Callable[[TimerEvent | None], None]
 
 #: [s] A reading whose ROS clock read is further than this from its monotonic stamp is not judged.
 PAIR_TOLERANCE = 2e-4
@@ -30,7 +34,7 @@ class MonotonicTimer:
         name: Of the thread.
     """
 
-    def __init__(self, period: float, callback: Callable[[Any], None], name: str = "timer") -> None:
+    def __init__(self, period: float, callback: TimerCallback, name: str = "timer") -> None:
         if not period > 0.0:
             raise ValueError(f"timer period must be > 0, got {period}")
         self._period = period
@@ -58,7 +62,7 @@ class MonotonicTimer:
         self._stop.set()
 
 
-def timer(period: float, callback: Callable[[Any], None]) -> rospy.Timer | MonotonicTimer:
+def timer(period: float, callback: TimerCallback) -> rospy.Timer | MonotonicTimer:
     """A periodic callback that survives clock jumps: on the wall clock a `MonotonicTimer` (callback gets
     None); under simulated time a `rospy.Timer` on the ROS clock that restarts its schedule after a backward
     jump instead of dying (callback gets its `TimerEvent`). Either has `shutdown()`."""

@@ -20,7 +20,7 @@ Example::
         topic: str = param("wrench", nonempty=True, doc="input topic")
 
     SCHEMA = schema_of(Settings)
-    settings = Settings(**SCHEMA.attrs(SCHEMA.load(params, prefix="~")))
+    settings = SCHEMA.build(Settings, SCHEMA.load(params, prefix="~"))
 """
 
 from __future__ import annotations
@@ -30,10 +30,11 @@ import dataclasses
 import functools
 import math
 from collections.abc import Callable, Iterable, Iterator, Mapping
-from typing import Any, Literal, TypeVar, cast
+from typing import Literal, TypeGuard, TypeVar, cast
 
 from compliant_common.errors import StackError
 from compliant_common.keys import unknown_key_message
+from compliant_common.typedefs import ParamMap
 
 __all__ = ["Param", "ParamType", "Schema", "SchemaError", "param", "schema_of"]
 
@@ -46,6 +47,7 @@ ParamType = Literal["str", "bool", "int", "float", "sign", "floats", "strings", 
 _TYPES: tuple[str, ...] = ("str", "bool", "int", "float", "sign", "floats", "strings", "mapping", "any")
 _META = "compliant_common.schema.param"
 _T = TypeVar("_T")
+_S = TypeVar("_S")
 
 
 class SchemaError(StackError):
@@ -67,7 +69,7 @@ class SchemaError(StackError):
         return self.message if self.message.startswith(f"{prefix}{self.key} ") else f"{prefix}{self}"
 
 
-def _is_number(value: Any) -> bool:
+def _is_number(value: object) -> TypeGuard[int | float]:
     return isinstance(value, int | float) and not isinstance(value, bool)
 
 
@@ -98,14 +100,14 @@ class Param:
 
     name: str
     type: ParamType
-    default: Any
+    default: object
     unit: str = ""
     doc: str = ""
     gt: float | None = None
     ge: float | None = None
     lt: float | None = None
     le: float | None = None
-    choices: tuple[Any, ...] = ()
+    choices: tuple[object, ...] = ()
     length: int | None = None
     nonempty: bool = False
     optional: bool = False
@@ -122,7 +124,7 @@ class Param:
             raise TypeError(f"parameter {self.name!r}: the default {self.default!r} is invalid: "
                             f"{exc.message}") from None
 
-    def convert(self, value: Any) -> Any:
+    def convert(self, value: object) -> object:
         """The value as the settings hold it (int to float, list to tuple), after checking it.
 
         Raises:
@@ -133,14 +135,15 @@ class Param:
         converted = self._typed(value)
         if self.choices and converted not in self.choices:
             raise SchemaError(self.name, f"must be one of {self.choices}, got {value!r}")
-        numbers = converted if self.type == "floats" else (converted,)
-        if self.type in ("int", "float", "floats") and not all(self._in_range(n) for n in numbers):
-            raise SchemaError(self.name, f"must be {self.range_text(markdown=False)}, got {value!r}")
+        if self.type in ("int", "float", "floats"):
+            numbers = converted if isinstance(converted, tuple) else (converted,)  # "floats": a tuple
+            if not all(_is_number(n) and self._in_range(n) for n in numbers):
+                raise SchemaError(self.name, f"must be {self.range_text(markdown=False)}, got {value!r}")
         if self.nonempty and not converted:
             raise SchemaError(self.name, "must not be empty")
         return converted
 
-    def _typed(self, value: Any) -> Any:
+    def _typed(self, value: object) -> object:
         kind = self.type
         if kind == "any":
             return value
@@ -176,7 +179,7 @@ class Param:
             return int(number)
         return number
 
-    def _float(self, value: Any) -> float:
+    def _float(self, value: object) -> float:
         if not _is_number(value):
             raise SchemaError(self.name, f"expected a number, got {value!r}")
         number = float(value)
@@ -219,7 +222,7 @@ class Param:
         """The default as the README shows it (YAML spelling: true, `""`, [0.0, 0.0, -9.81])."""
         return self.shown_default or self._value_text(self.default)
 
-    def _value_text(self, value: Any, quote: bool = True) -> str:
+    def _value_text(self, value: object, quote: bool = True) -> str:
         if value is None:
             return "none"
         if isinstance(value, bool):
@@ -260,7 +263,7 @@ class Schema(Mapping[str, Param]):
         """The keys, in declaration order."""
         return tuple(self._params)
 
-    def defaults(self) -> dict[str, Any]:
+    def defaults(self) -> dict[str, object]:
         """Key -> default."""
         return {p.name: p.default for p in self.values()}
 
@@ -285,7 +288,7 @@ class Schema(Mapping[str, Param]):
             known = [*self._params, *also_known]
             raise SchemaError(unknown[0], unknown_key_message(unknown[0], known, prefix))
 
-    def convert(self, params: Mapping[str, Any]) -> dict[str, Any]:
+    def convert(self, params: ParamMap) -> dict[str, object]:
         """The declared keys present in `params`, converted and checked (other keys are ignored).
 
         Raises:
@@ -294,8 +297,8 @@ class Schema(Mapping[str, Param]):
         return {p.name: p.convert(params[p.name]) for p in self.values() if p.name in params}
 
     def load(
-        self, params: Mapping[str, Any], prefix: str = "", also_known: Iterable[str] = ()
-    ) -> dict[str, Any]:
+        self, params: ParamMap, prefix: str = "", also_known: Iterable[str] = ()
+    ) -> dict[str, object]:
         """Start-up validation: unknown keys refused, then the given values converted (absent keys are left
         out: the settings' defaults apply).
 
@@ -305,7 +308,7 @@ class Schema(Mapping[str, Param]):
         self.refuse_unknown(params, prefix, also_known)
         return self.convert(params)
 
-    def check(self, values: Mapping[str, Any]) -> None:
+    def check(self, values: ParamMap) -> None:
         """Checks values already in settings form (e.g. a settings object's fields by key).
 
         Raises:
@@ -315,11 +318,16 @@ class Schema(Mapping[str, Param]):
             if p.name in values:
                 p.convert(values[p.name])
 
-    def attrs(self, values: Mapping[str, Any]) -> dict[str, Any]:
+    def attrs(self, values: ParamMap) -> dict[str, object]:
         """Key -> value turned into settings attribute -> value (keys without an attribute dropped)."""
         return {self._params[k].attr: v for k, v in values.items() if self._params[k].attr}
 
-    def values_of(self, settings: Any) -> dict[str, Any]:
+    def build(self, settings_class: type[_S], values: ParamMap) -> _S:
+        """The settings object of checked values (key -> value, as `load` returns them): the class called
+        with `attrs(values)` as keyword arguments (the class's own checks run as usual)."""
+        return settings_class(**self.attrs(values))
+
+    def values_of(self, settings: object) -> dict[str, object]:
         """Key -> the value a settings object holds."""
         return {p.name: getattr(settings, p.attr) for p in self.values() if p.attr}
 
@@ -333,7 +341,7 @@ class Schema(Mapping[str, Param]):
         return "\n".join(rows) + "\n"
 
 
-def _infer_type(default: Any) -> ParamType:
+def _infer_type(default: object) -> ParamType:
     for kind, cls in (("bool", bool), ("int", int), ("float", float), ("str", str)):
         if isinstance(default, cls):
             return cast(ParamType, kind)
@@ -350,7 +358,7 @@ def param(
     ge: float | None = None,
     lt: float | None = None,
     le: float | None = None,
-    choices: tuple[Any, ...] = (),
+    choices: tuple[object, ...] = (),
     length: int | None = None,
     nonempty: bool = False,
     optional: bool = False,
@@ -369,8 +377,8 @@ def param(
     )
     metadata = {_META: spec}
     if isinstance(default, list | dict | set):  # mutable: each settings object gets its own copy
-        factory: Callable[[], Any] = functools.partial(copy.copy, default)
-        return cast(_T, dataclasses.field(default_factory=factory, metadata=metadata))
+        factory: Callable[[], _T] = functools.partial(copy.copy, default)
+        return dataclasses.field(default_factory=factory, metadata=metadata)
     return dataclasses.field(default=default, metadata=metadata)
 
 

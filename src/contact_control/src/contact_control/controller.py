@@ -21,9 +21,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any, NamedTuple
+from typing import NamedTuple
 
 import numpy as np
+from compliant_common.typedefs import FloatArray
 
 from contact_control.axes import (
     AXES,
@@ -52,7 +53,7 @@ from contact_control.loop_gain import GainBound
 from contact_control.noise_floor import NoiseFloor
 from contact_control.oscillation import OscillationWatch, halved
 from contact_control.params import ContactControlSettings
-from contact_control.preprocess import PreprocessError, WrenchPreprocessor, as_rows, is_finite6
+from contact_control.preprocess import Matrix, PreprocessError, WrenchPreprocessor, as_rows, is_finite6
 from contact_control.rate import SamplePeriod
 from contact_control.request import FAILURE, SET_CONTROL_FORCE_FAILED, RequestError
 from contact_control.travel import TravelMeter
@@ -149,7 +150,7 @@ class CycleResult:
         return self.move_active or any(self.reacting)
 
     @property
-    def twist(self) -> np.ndarray:
+    def twist(self) -> FloatArray:
         """The commanded twist as a numpy array (6,), control frame."""
         return np.array(self.velocity)
 
@@ -240,7 +241,7 @@ class ContactControl:
                        if s.drift_window > 0.0 else None)
         self._drift_next = 0.0  # when the drift watch takes its next sample [s]
         self._last_raw: Sequence[float] | None = None
-        self._last_R: Any = None
+        self._last_R: Matrix | None = None
         self.last_result = self._result(0.0, SAFETY_STALE, "no wrench yet")
 
     # --- state ---
@@ -332,9 +333,9 @@ class ContactControl:
     def set_laws(
         self,
         laws: Sequence[AxisLaw],
-        eef_pose: Any = None,
+        eef_pose: Matrix | None = None,
         t: float | None = None,
-        R_fixed_control: Any = None,
+        R_fixed_control: Matrix | None = None,
     ) -> int:
         """Starts a move with six laws (x, y, z, rx, ry, rz), replacing any running move at once.
 
@@ -477,7 +478,9 @@ class ContactControl:
         self._end_move(-1, END_EXTERNAL_STOP, False, reason)
         return True
 
-    def tare(self, wrench: Sequence[float] | None = None, R_world_sensor: Any = None) -> tuple[float, ...]:
+    def tare(
+        self, wrench: Sequence[float] | None = None, R_world_sensor: Matrix | None = None
+    ) -> tuple[float, ...]:
         """Zeroes the sensor at the current (or given) reading; see `WrenchPreprocessor.tare`.
 
         Raises:
@@ -530,10 +533,10 @@ class ContactControl:
         self,
         wrench: Sequence[float],
         t: float,
-        T_control_sensor: Any = None,
-        R_world_sensor: Any = None,
-        eef_pose: Any = None,
-        R_fixed_control: Any = None,
+        T_control_sensor: Matrix | None = None,
+        R_world_sensor: Matrix | None = None,
+        eef_pose: Matrix | None = None,
+        R_fixed_control: Matrix | None = None,
         stamp: float | None = None,
     ) -> CycleResult:
         """One control cycle for a received wrench.
@@ -676,7 +679,10 @@ class ContactControl:
         self.notes.append(note)
 
     def contact_force(
-        self, wrench: Sequence[float], T_control_sensor: Any = None, R_world_sensor: Any = None
+        self,
+        wrench: Sequence[float],
+        T_control_sensor: Matrix | None = None,
+        R_world_sensor: Matrix | None = None,
     ) -> tuple[float, float, float] | None:
         """The contact force of a raw wrench, unfiltered: sign flips, bias and tool weight out, in the control
         frame [N]; None for a NaN/inf wrench or a missing orientation. For guards that must see a contact as
@@ -773,7 +779,7 @@ class ContactControl:
         not yet measured)."""
         return None if self._drift is None else self._drift.drift
 
-    def _watch_drift(self, wrench: Sequence[float], R_world_sensor: Any, t: float) -> None:
+    def _watch_drift(self, wrench: Sequence[float], R_world_sensor: Matrix | None, t: float) -> None:
         """A sample at rest for the drift watch; re-tares when the policy says so."""
         assert self._drift is not None
         try:

@@ -10,10 +10,10 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
 
 from compliant_common.errors import StackError
 from compliant_common.schema import SchemaError, param, schema_of
+from compliant_common.typedefs import ParamMap
 
 __all__ = ["PARAMETERS", "AxisTuning", "ContactControlSettings", "ParamError", "load_settings"]
 
@@ -26,15 +26,15 @@ class ParamError(StackError):
         self.key = key
 
 
-def _pos(default: float, unit: str, doc: str) -> Any:
+def _pos(default: float, unit: str, doc: str) -> float:
     return param(default, unit=unit, gt=0.0, doc=doc)
 
 
-def _nonneg(default: float, unit: str, doc: str) -> Any:
+def _nonneg(default: float, unit: str, doc: str) -> float:
     return param(default, unit=unit, ge=0.0, doc=doc)
 
 
-def _sign(doc: str) -> Any:
+def _sign(doc: str) -> int:
     return param(1, type="sign", doc=doc)
 
 
@@ -344,7 +344,7 @@ class AxisTuning:
 PARAMETERS = schema_of(ContactControlSettings)
 
 
-def load_settings(params: Mapping[str, Any] | None = None) -> ContactControlSettings:
+def load_settings(params: ParamMap | None = None) -> ContactControlSettings:
     """Builds validated settings from a parameter dict.
 
     Args:
@@ -358,7 +358,7 @@ def load_settings(params: Mapping[str, Any] | None = None) -> ContactControlSett
         ParamError: an unknown key (naming the closest valid one), a value of the wrong type or out of
             range, or a broken cross-constraint.
     """
-    merged: dict[str, Any] = {}
+    merged: dict[str, object] = {}
     params = dict(params or {})
     nested = params.pop("contact_control", None)
     if nested is not None:
@@ -370,7 +370,7 @@ def load_settings(params: Mapping[str, Any] | None = None) -> ContactControlSett
         values = PARAMETERS.load(merged)
     except SchemaError as err:
         raise ParamError(err.key, err.message) from None
-    settings = ContactControlSettings(**PARAMETERS.attrs(values))
+    settings = PARAMETERS.build(ContactControlSettings, values)
     _check_cross_constraints(settings)
     return settings
 

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from compliant_common.errors import StackError
+from compliant_common.typedefs import FloatArray
 
 __all__ = ["PayloadError", "PayloadFit", "fit_payload", "gravity_in_sensor", "read_csv_samples"]
 
@@ -76,7 +77,7 @@ def gravity_in_sensor(
     return tuple((r.T @ np.asarray(gravity, dtype=float)).tolist())
 
 
-def _skew(u: np.ndarray) -> np.ndarray:
+def _skew(u: FloatArray) -> FloatArray:
     return np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
 
 

@@ -8,10 +8,9 @@ from __future__ import annotations
 import math
 import threading
 from collections.abc import Callable, Sequence
-from typing import Any
 
 import rospy
-from std_srvs.srv import Trigger, TriggerResponse
+from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 
 from contact_control.payload import PayloadError, fit_payload, gravity_in_sensor
 
@@ -64,7 +63,7 @@ class PayloadServices:
             if len(buffer) == SAMPLES_PER_POSE:
                 self._full.set()
 
-    def _on_add(self, _req: Any) -> TriggerResponse:
+    def _on_add(self, _req: TriggerRequest) -> TriggerResponse:
         why = self._busy()
         if why:
             return TriggerResponse(success=False, message=f"not sampling: {why}")
@@ -98,7 +97,7 @@ class PayloadServices:
             f"({w}); identify needs 3 or more orientations, 6 tilted about two axes are better",
         )
 
-    def _on_identify(self, _req: Any) -> TriggerResponse:
+    def _on_identify(self, _req: TriggerRequest) -> TriggerResponse:
         try:
             fit = fit_payload(self.samples)
         except PayloadError as err:
@@ -106,7 +105,7 @@ class PayloadServices:
         rospy.loginfo("contact_control: payload identified: %s", fit.describe())
         return TriggerResponse(success=True, message=f"{fit.describe()}\n{fit.yaml_keys()}")
 
-    def _on_clear(self, _req: Any) -> TriggerResponse:
+    def _on_clear(self, _req: TriggerRequest) -> TriggerResponse:
         count = len(self.samples)
         self.samples.clear()
         return TriggerResponse(success=True, message=f"{count} samples cleared")

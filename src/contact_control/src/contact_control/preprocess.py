@@ -13,24 +13,32 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
+from typing import TypeAlias
 
 from compliant_common.errors import StackError
+from compliant_common.typedefs import FloatArray
 
 from contact_control.axes import SAFETY_NAN, SAFETY_OK, SAFETY_OVER_LIMIT
 from contact_control.filters import LowPass
 from contact_control.params import ContactControlSettings
 
-__all__ = ["PreprocessError", "WrenchPreprocessor", "as_rows", "is_finite6"]
+__all__ = ["Matrix", "PreprocessError", "WrenchPreprocessor", "as_rows", "is_finite6"]
 
 
 class PreprocessError(StackError):
     """Bad input to a preprocessing request (tare with invalid data, missing orientation)."""
 
 
-def as_rows(matrix: Any) -> Sequence[Sequence[float]]:
+#: A rotation (3x3) or transform (4x4): row-major nested sequences or a numpy array.
+Matrix: TypeAlias = Sequence[Sequence[float]] | FloatArray
+
+
+def as_rows(matrix: Matrix) -> Sequence[Sequence[float]]:
     """Nested rows of a matrix; numpy arrays are converted once (indexing them per element is slow)."""
-    return matrix.tolist() if hasattr(matrix, "tolist") else matrix
+    if hasattr(matrix, "tolist"):
+        rows: list[list[float]] = matrix.tolist()
+        return rows
+    return matrix
 
 
 def is_finite6(w: Sequence[float]) -> bool:
@@ -118,7 +126,7 @@ class WrenchPreprocessor:
         return cutoff
 
     # --- tool gravity and tare ---
-    def gravity_wrench(self, R_world_sensor: Any) -> list[float]:
+    def gravity_wrench(self, R_world_sensor: Matrix | None) -> list[float]:
         """The tool's weight as the sensor reads it at this orientation (sensor frame, about its origin)."""
         if not self._mass:
             return [0.0] * 6
@@ -145,7 +153,7 @@ class WrenchPreprocessor:
                 w[i + 3] *= self._signs[i]
         return w
 
-    def tare(self, raw: Sequence[float], R_world_sensor: Any = None) -> tuple[float, ...]:
+    def tare(self, raw: Sequence[float], R_world_sensor: Matrix | None = None) -> tuple[float, ...]:
         """Makes the current reading the zero: stores the bias net of the tool's expected weight here.
 
         After tare the compensated wrench is zero at this orientation and stays near zero when the sensor
@@ -159,7 +167,7 @@ class WrenchPreprocessor:
             self._filter.reset()
         return tuple(self._bias)
 
-    def bias_estimate(self, raw: Sequence[float], R_world_sensor: Any = None) -> list[float]:
+    def bias_estimate(self, raw: Sequence[float], R_world_sensor: Matrix | None = None) -> list[float]:
         """The bias that would make this reading zero (what `tare` stores), changing nothing.
 
         Raises:
@@ -172,7 +180,7 @@ class WrenchPreprocessor:
         return [w[i] - expected[i] for i in range(6)]
 
     def contact_force(
-        self, raw: Sequence[float], R_world_sensor: Any = None
+        self, raw: Sequence[float], R_world_sensor: Matrix | None = None
     ) -> tuple[float, float, float] | None:
         """The force of a raw wrench with sign flips, bias and the tool's weight taken out, sensor frame [N],
         unfiltered and unchecked (no state changes); None for a NaN/inf wrench or, with a tool mass, a
@@ -198,7 +206,10 @@ class WrenchPreprocessor:
 
     # --- the cycle ---
     def process(
-        self, raw: Sequence[float], T_control_sensor: Any = None, R_world_sensor: Any = None
+        self,
+        raw: Sequence[float],
+        T_control_sensor: Matrix | None = None,
+        R_world_sensor: Matrix | None = None,
     ) -> tuple[int, list[float] | None]:
         """One sample through the chain.
 

@@ -21,10 +21,10 @@ Only the fields an axis's law uses are read and checked. The request has no d_of
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from types import SimpleNamespace
-from typing import Any
+from typing import TYPE_CHECKING, TypeAlias, TypeVar
 
 from compliant_common.errors import StackError
 
@@ -41,6 +41,23 @@ from contact_control.axes import (
     LAW_SPRING,
 )
 from contact_control.laws import AxisLaw
+from contact_control.params import ContactControlSettings
+
+if TYPE_CHECKING:  # for annotations only: this module imports no ROS package
+    from cartesian_impedance_msgs.msg import SetCartesianImpedance
+    from cartesian_impedance_msgs.srv import ConfigureForceControlRequest
+    from compliant_control_msgs.srv import ConfigureLawsRequest
+    from geometry_msgs.msg import Vector3
+
+#: A ConfigureForceControl request: the genpy message, or the same attribute tree of SimpleNamespaces
+#: (`empty_request`).
+ForceControlRequest: TypeAlias = "ConfigureForceControlRequest | SimpleNamespace"
+#: A compliant_control_msgs/ConfigureLaws request: the genpy message or `empty_laws_request()`.
+LawsRequest: TypeAlias = "ConfigureLawsRequest | SimpleNamespace"
+_ImpedanceParams: TypeAlias = "SetCartesianImpedance | SimpleNamespace"
+_Vector3: TypeAlias = "Vector3 | SimpleNamespace"
+_ForceRequestT = TypeVar("_ForceRequestT", bound=ForceControlRequest)
+_LawsRequestT = TypeVar("_LawsRequestT", bound=LawsRequest)
 
 __all__ = [
     "CODE_NAMES",
@@ -50,6 +67,8 @@ __all__ = [
     "SET_DOF_FAILED",
     "SET_FORCE_STIFFNESS_FAILED",
     "SUCCESS",
+    "ForceControlRequest",
+    "LawsRequest",
     "RequestError",
     "RequestLimits",
     "axis_groups",
@@ -106,7 +125,7 @@ class RequestLimits:
     default_angular_velocity: float | None = None  # [rad/s]
 
     @classmethod
-    def from_settings(cls, settings: Any) -> RequestLimits:
+    def from_settings(cls, settings: ContactControlSettings) -> RequestLimits:
         """Limits from a `ContactControlSettings`."""
         return cls(
             settings.max_velocity,
@@ -118,7 +137,9 @@ class RequestLimits:
         )
 
 
-def axis_groups(params: Any, axis: int) -> tuple[Any, Any, Any, Any, Any]:
+def axis_groups(
+    params: _ImpedanceParams, axis: int
+) -> tuple[_Vector3, _Vector3, _Vector3, _Vector3, _Vector3]:
     """The five Vector3 of `cart_impedance_params` an axis reads (b, k, V_desired, limit, max travel).
 
     Args:
@@ -173,7 +194,7 @@ def laws_fields(axis: int) -> dict[str, str]:
     }
 
 
-def _fields(req: Any, axis: int) -> tuple[int, float, float, float, float, float]:
+def _fields(req: ForceControlRequest, axis: int) -> tuple[int, float, float, float, float, float]:
     c = AXES[axis][-1]
     groups = axis_groups(req.cart_impedance_params, axis)
     law = getattr(req.direction_control_laws, AXES[axis]).type
@@ -304,7 +325,7 @@ def _tracking_law(
     action: int,
     target: float,
     limits: RequestLimits,
-    fail: Any,
+    fail: Callable[[int, str, str], RequestError],
 ) -> AxisLaw:
     """The force tracking law of one axis (V = (F - target) / b), checked; `fail` builds the refusal."""
     angular = axis >= 3
@@ -346,7 +367,7 @@ def _tracking_law(
     )
 
 
-def _global_action(action: Any) -> int:
+def _global_action(action: SimpleNamespace) -> int:
     """The one exceeded action the original message's three flags select (all false: stop)."""
     chosen = [name for name in ("stop", "gravity_compensation", "move_away") if getattr(action, name)]
     if len(chosen) > 1:
@@ -359,7 +380,7 @@ def _global_action(action: Any) -> int:
     return codes[chosen[0]] if chosen else EXCEEDED_STOP
 
 
-def validate_request(req: Any, limits: RequestLimits | None = None) -> list[AxisLaw]:
+def validate_request(req: ForceControlRequest, limits: RequestLimits | None = None) -> list[AxisLaw]:
     """Maps a ConfigureForceControl request to six `AxisLaw`s (x, y, z, rx, ry, rz), or refuses it.
 
     The message's one `exceeded_action` applies to every axis with a force/torque limit > 0; axes without a
@@ -385,7 +406,7 @@ def validate_request(req: Any, limits: RequestLimits | None = None) -> list[Axis
     return [_axis_law(axis, raw[axis], limits, force_control_fields(axis), code) for axis in range(6)]
 
 
-def validate_laws_request(req: Any, limits: RequestLimits | None = None) -> list[AxisLaw]:
+def validate_laws_request(req: LawsRequest, limits: RequestLimits | None = None) -> list[AxisLaw]:
     """Maps a compliant_control_msgs/ConfigureLaws request (fields x .. rz, AxisLaw messages) to six laws.
 
     As `validate_request`, with a per-axis exceeded action; an exceeded action other than stop on an axis
@@ -446,7 +467,7 @@ def empty_request() -> SimpleNamespace:
     )
 
 
-def fill_request(req: Any, laws: Sequence[AxisLaw]) -> Any:
+def fill_request(req: _ForceRequestT, laws: Sequence[AxisLaw]) -> _ForceRequestT:
     """Writes six laws into a request (genpy message or `empty_request()`) and returns it; drops d_offset.
 
     The exceeded_action flags get the laws' common action (stop when no axis has a force limit).
@@ -490,7 +511,7 @@ def empty_laws_request() -> SimpleNamespace:
     return SimpleNamespace(**{name: SimpleNamespace(**dict.fromkeys(fields, 0)) for name in AXES})
 
 
-def fill_laws_request(req: Any, laws: Sequence[AxisLaw]) -> Any:
+def fill_laws_request(req: _LawsRequestT, laws: Sequence[AxisLaw]) -> _LawsRequestT:
     """Writes six laws into a ConfigureLaws request (genpy message or `empty_laws_request()`)."""
     if len(laws) != 6:
         raise ValueError(f"need 6 laws (x, y, z, rx, ry, rz), got {len(laws)}")

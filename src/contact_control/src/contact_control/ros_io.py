@@ -10,17 +10,21 @@ from __future__ import annotations
 import contextlib
 import threading
 from collections.abc import Callable, Sequence
-from typing import Any
 
 import rospy
 import tf2_ros
 from cartesian_impedance_msgs.msg import CartesianForceCtrlErrorCodes
-from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlResponse
+from cartesian_impedance_msgs.srv import (
+    ConfigureForceControl,
+    ConfigureForceControlRequest,
+    ConfigureForceControlResponse,
+)
 from compliant_common.ros_time import timer
 from compliant_control_msgs.msg import AxisState, ContactControlStatus
-from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsResponse
+from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsRequest, ConfigureLawsResponse
 from geometry_msgs.msg import TwistStamped, WrenchStamped
-from std_srvs.srv import Trigger, TriggerResponse
+from rospy.timer import TimerEvent
+from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 
 from contact_control.axes import AXES, END_NAMES, EXCEEDED_ACTION_NAMES, LAW_NAMES, SAFETY_NAMES
 from contact_control.controller import CycleResult
@@ -28,7 +32,7 @@ from contact_control.frames import transform
 from contact_control.params import ContactControlSettings, ParamError, load_settings
 from contact_control.payload_service import PayloadServices
 from contact_control.request import CODE_NAMES
-from contact_control.stage import ContactStage, Velocity
+from contact_control.stage import Answer, ContactStage, Velocity
 
 __all__ = ["ContactControlRos", "TfPoses", "fill_status_words", "read_settings"]
 
@@ -178,7 +182,9 @@ class ContactControlRos:
         self.after()
 
     # --- requests ---
-    def _configure(self, req: Any, per_axis: bool, service: str) -> Any:
+    def _configure(
+        self, req: ConfigureForceControlRequest | ConfigureLawsRequest, per_axis: bool, service: str
+    ) -> Answer:
         answer = self._stage.configure(req, rospy.get_time(), per_axis)
         if answer.ok:
             rospy.loginfo("%s", answer.message)
@@ -188,7 +194,7 @@ class ContactControlRos:
         self.after()
         return answer
 
-    def _on_configure_laws(self, req: Any) -> ConfigureLawsResponse:
+    def _on_configure_laws(self, req: ConfigureLawsRequest) -> ConfigureLawsResponse:
         """compliant_control_msgs/ConfigureLaws: per-axis laws; the answer carries the code and the reason."""
         with self._lock:
             answer = self._configure(req, True, "configure_laws")
@@ -199,11 +205,11 @@ class ContactControlRos:
         # CartesianForceCtrlErrorCodes has constants only, no field: the code goes to the log and ~status.
         return ConfigureForceControlResponse(success=success, error=CartesianForceCtrlErrorCodes())
 
-    def _on_configure(self, req: Any) -> ConfigureForceControlResponse:
+    def _on_configure(self, req: ConfigureForceControlRequest) -> ConfigureForceControlResponse:
         with self._lock:
             return self._response(self._configure(req, False, "configure_cartesian_impedance").ok)
 
-    def _on_configure_blocking(self, req: Any) -> ConfigureForceControlResponse:
+    def _on_configure_blocking(self, req: ConfigureForceControlRequest) -> ConfigureForceControlResponse:
         with self._lock:
             answer = self._configure(req, False, "configure_cartesian_impedance_blocking")
             if not answer.ok:
@@ -216,7 +222,7 @@ class ContactControlRos:
                     return self._response(False)
                 self._ended.wait(0.1)
 
-    def _on_tare(self, _req: Any) -> TriggerResponse:
+    def _on_tare(self, _req: TriggerRequest) -> TriggerResponse:
         """Zeroes over a steady window as at start-up (the laws hold still meanwhile) and answers with the
         bias and the noise floor; gives up, keeping the old bias, after `TARE_TIMEOUT` s more than the
         window without a steady one (the reason in the answer)."""
@@ -236,13 +242,13 @@ class ContactControlRos:
         message = "bias [N, Nm]: " + ", ".join(f"{b:.4g}" for b in bias)
         return TriggerResponse(success=True, message=message + ("; " + floor.describe() if floor else ""))
 
-    def _on_stop(self, _req: Any) -> TriggerResponse:
+    def _on_stop(self, _req: TriggerRequest) -> TriggerResponse:
         with self._lock:
             zero = self._stage.stop("stop service")
             self.emit_locked(zero, rospy.get_time())
         return TriggerResponse(success=True, message="move stopped" if zero else "no move was running")
 
-    def _on_reset(self, _req: Any) -> TriggerResponse:
+    def _on_reset(self, _req: TriggerRequest) -> TriggerResponse:
         with self._lock:
             was = self._stage.ctrl.reset_safety()
         message = "safety latch cleared" if was else "safety was not latched"
@@ -268,7 +274,7 @@ class ContactControlRos:
             self.emit_locked(self._stage.stop("shutdown"), rospy.get_time())
 
     # --- status ---
-    def _on_status(self, _event: Any) -> None:
+    def _on_status(self, _event: TimerEvent | None) -> None:
         if self._status_pub.get_num_connections() == 0:  # nobody listening: save the work
             return
         with self._lock:
@@ -296,7 +302,7 @@ class ContactControlRos:
         self._status_pub.publish(msg)
 
 
-def fill_status_words(msg: Any, result: CycleResult) -> None:
+def fill_status_words(msg: ContactControlStatus, result: CycleResult) -> None:
     """The names beside the codes of a ContactControlStatus (so `rostopic echo` reads in words)."""
     msg.safety_name = SAFETY_NAMES.get(result.safety, str(result.safety))
     msg.reacting = any(result.reacting)

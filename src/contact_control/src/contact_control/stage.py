@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from typing import Any, NamedTuple
+from typing import NamedTuple
 
 from contact_control.axes import (
     AXES,
@@ -23,10 +23,13 @@ from contact_control.axes import (
     SAFETY_NO_TF,
 )
 from contact_control.controller import ContactControl, CycleResult
-from contact_control.frames import IDENTITY, compose, inverse, rotate_twist, rotation, transpose_times
+from contact_control.frames import IDENTITY, Rows, compose, inverse, rotate_twist, rotation, transpose_times
+from contact_control.laws import AxisLaw
 from contact_control.params import ContactControlSettings
 from contact_control.request import (
     SUCCESS,
+    ForceControlRequest,
+    LawsRequest,
     RequestError,
     RequestLimits,
     validate_laws_request,
@@ -90,7 +93,8 @@ class ContactStage:
         self._fault_shown_until = 0.0
         self._cycle_poses: dict[str, list[list[float]]] = {}
         self._last_raw: Sequence[float] = ZERO
-        self._last_frames: tuple[Any, Any] = (None, None)  # T_control_sensor, R_world_sensor of that wrench
+        # T_control_sensor, R_world_sensor of that wrench
+        self._last_frames: tuple[Rows | None, Rows | None] = (None, None)
         self._have_frames = False
         self._last_t = 0.0
         #: The latest compensated, unfiltered contact force ((fx, fy, fz) [N], control frame, t [s]) or None.
@@ -109,7 +113,9 @@ class ContactStage:
             self._cycle_poses[frame] = pose
         return pose
 
-    def _frames(self, sensor_frame: str) -> tuple[Any, Any, Any, Any, Any]:
+    def _frames(
+        self, sensor_frame: str
+    ) -> tuple[Rows | None, Rows | None, Rows | None, Rows | None, Rows | None]:
         """(T_control_sensor, R_world_sensor, T_fixed_eef, R_fixed_control, R_command_control) for one cycle;
         None stands for "same frame" or "not needed".
 
@@ -207,7 +213,7 @@ class ContactStage:
         self._fault_note = ""
 
     # --- publish policy ---
-    def _emit(self, result: CycleResult, R_command_control: Any = None) -> Velocity | None:
+    def _emit(self, result: CycleResult, R_command_control: Rows | None = None) -> Velocity | None:
         """The twist to send for a cycle's result, per the publish policy; notes a move's end."""
         velocity: Velocity | None = None
         if result.commanding:  # a move, or an exceeded action after it (moving away, hand-guiding)
@@ -228,7 +234,9 @@ class ContactStage:
         return velocity
 
     # --- requests ---
-    def configure(self, req: Any, t: float, per_axis: bool = False) -> Answer:
+    def configure(
+        self, req: ForceControlRequest | LawsRequest, t: float, per_axis: bool = False
+    ) -> Answer:
         """Validates and applies a ConfigureForceControl (or, `per_axis`, a ConfigureLaws) request:
         (accepted, code, the laws in words or the reason for refusing)."""
         validate = validate_laws_request if per_axis else validate_request
@@ -271,7 +279,7 @@ class ContactStage:
         return r, "; ".join(m for m in (fault, r.message, self._request_note) if m)
 
 
-def describe_laws(move_id: int, laws: Sequence[Any]) -> str:
+def describe_laws(move_id: int, laws: Sequence[AxisLaw]) -> str:
     """The accepted laws in words, e.g. "contact laws set (move 3): z=compliant_move (v -0.01, move_away)".
 
     A compliant move shows its velocity: it may be the default one, in the direction the node chose.

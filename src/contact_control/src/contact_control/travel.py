@@ -9,9 +9,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
 
-from contact_control.preprocess import as_rows
+from contact_control.preprocess import Matrix, as_rows
 
 __all__ = ["TravelMeter", "rotation_vector"]
 
@@ -56,14 +55,14 @@ class TravelMeter:
     def clear(self) -> None:
         self._p0 = None
 
-    def start(self, T_fixed_eef: Any, R_fixed_control: Any = None) -> None:
+    def start(self, T_fixed_eef: Matrix, R_fixed_control: Matrix | None = None) -> None:
         """Sets the start pose (4x4, fixed frame) and the control axes (3x3, fixed frame) to measure along."""
         m = as_rows(T_fixed_eef)
         self._p0 = [m[0][3], m[1][3], m[2][3]]
         self._r0 = [row[:3] for row in m[:3]]
         self._rc = _IDENTITY if R_fixed_control is None else as_rows(R_fixed_control)
 
-    def measure(self, T_fixed_eef: Any, out: list[float]) -> None:
+    def measure(self, T_fixed_eef: Matrix, out: list[float]) -> None:
         """Writes the travel (x, y, z [m], rx, ry, rz [rad]) into `out`; zeros before `start`."""
         if self._p0 is None:
             out[:] = (0.0,) * 6

@@ -17,11 +17,12 @@ from __future__ import annotations
 import collections
 import time
 from collections.abc import Callable, Sequence
-from typing import Any, NamedTuple
+from typing import NamedTuple
 
 from compliant_common.clock import ClockWatch
 from contact_control.controller import CycleResult
 from contact_control.params import ContactControlSettings
+from contact_control.request import ForceControlRequest, LawsRequest
 from contact_control.stage import ZERO, Answer, ContactStage, PoseSource, Velocity
 from jog_arm.settings import JogSettings
 from jog_arm.stage import JogCycle, JogStage
@@ -200,7 +201,9 @@ class CompliantPipeline:
         return out
 
     # --- requests and status ---
-    def configure(self, request: Any, t: float, per_axis: bool = False) -> Answer:
+    def configure(
+        self, request: ForceControlRequest | LawsRequest, t: float, per_axis: bool = False
+    ) -> Answer:
         """A ConfigureForceControl (or, `per_axis`, a ConfigureLaws) request: (ok, code, message, move_id),
         the laws in words or the reason for refusing. Nothing changes when it is refused."""
         return self.contact.configure(request, t, per_axis)

@@ -8,6 +8,7 @@ rotated every cycle, at the cycle's configuration.
 from __future__ import annotations
 
 import numpy as np
+from compliant_common.typedefs import FloatArray
 
 from jog_arm.kinematics import ArmModel, KinematicsError
 
@@ -20,7 +21,7 @@ class CommandFrame:
     __slots__ = ("extra", "frame_id", "on_chain", "static", "static_rows")
 
     def __init__(
-        self, frame_id: int, static: np.ndarray | None, on_chain: bool, extra: np.ndarray | None
+        self, frame_id: int, static: FloatArray | None, on_chain: bool, extra: FloatArray | None
     ) -> None:
         self.frame_id = frame_id
         self.static = static  # root <- frame rotation if it never moves, else None
@@ -53,7 +54,7 @@ class CommandFrames:
             self._frames[name] = frame
         return frame
 
-    def add(self, name: str, parent: str, rotation: np.ndarray) -> None:
+    def add(self, name: str, parent: str, rotation: FloatArray) -> None:
         """Makes a frame the model does not know usable for commands, fixed relative to a model frame.
 
         Args:
@@ -75,7 +76,7 @@ class CommandFrames:
         static = None if base.static is None else base.static @ rot
         self._frames[name.lstrip("/")] = CommandFrame(base.frame_id, static, base.on_chain, extra)
 
-    def rotation(self, frame: CommandFrame, q: np.ndarray) -> np.ndarray:
+    def rotation(self, frame: CommandFrame, q: FloatArray) -> FloatArray:
         """Root <- `frame` rotation at configuration `q` (model order), for a frame that moves.
 
         A frame on the tip's chain is read from the placements the cycle's Jacobian left in the model's

@@ -12,6 +12,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from compliant_common.typedefs import FloatArray
 
 from jog_arm.command_frames import CommandFrame, CommandFrames
 from jog_arm.settings import JogSettings
@@ -167,7 +168,7 @@ class CommandState:
             return StatusCode.STALE_COMMAND, f"no command for {age:.3f} s (incoming_cmd_timeout)"
         return StatusCode.NO_WARNING, "zero command" if self.zero else ""
 
-    def in_root_axes(self, q: np.ndarray) -> np.ndarray:
+    def in_root_axes(self, q: FloatArray) -> FloatArray:
         """The command's twist in root axes at configuration `q`, linear part divided by
         `singularity_length_scale` (a shared array, valid until the next call). Call only while following
         a command; for a frame that moves, after the cycle's Jacobian (see `CommandFrames.rotation`)."""

@@ -13,6 +13,7 @@ import math
 
 import eigenpy
 import numpy as np
+from compliant_common.typedefs import FloatArray
 
 from jog_arm.kinematics import ArmModel
 from jog_arm.limits import singularity_scale
@@ -39,8 +40,8 @@ class Geometry:
     def __init__(self) -> None:
         self.valid = False
         self.q: list[float] = []
-        self.q_arr: np.ndarray = np.zeros(0)
-        self.J: np.ndarray = np.zeros((6, 0))
+        self.q_arr: FloatArray = np.zeros(0)
+        self.J: FloatArray = np.zeros((6, 0))
         self.condition = math.inf
 
 
@@ -55,7 +56,7 @@ class DampedSolver:
         posture: The null-space posture (model order), None: the configuration where motion starts.
     """
 
-    def __init__(self, model: ArmModel, settings: JogSettings, posture: np.ndarray | None) -> None:
+    def __init__(self, model: ArmModel, settings: JogSettings, posture: FloatArray | None) -> None:
         self._model = model
         n = model.nv
         self._period = settings.pub_period
@@ -81,7 +82,7 @@ class DampedSolver:
         self.q_arr = np.zeros(n)
         self._geom = Geometry()
 
-    def start_motion(self, q_arr: np.ndarray) -> None:
+    def start_motion(self, q_arr: FloatArray) -> None:
         """Motion starts at `q_arr`: without a configured posture, the null space pulls back toward it."""
         if not self._posture_fixed:
             np.multiply(q_arr, self._ns_gain, out=self._gain_posture)
@@ -125,19 +126,21 @@ class DampedSolver:
         g.valid = True
         return g
 
-    def solve(self, J: np.ndarray, x: np.ndarray, q_arr: np.ndarray, scale: float) -> np.ndarray:
+    def solve(self, J: FloatArray, x: FloatArray, q_arr: FloatArray, scale: float) -> FloatArray:
         """dq = J⁺x with the J⁺ of the last :meth:`geometry` (whose `J` this is); on a redundant arm plus
         the null-space pull toward the posture, scaled by `scale`:
         J⁺x + (I - J⁺J)·pull = J⁺(x - J·pull) + pull."""
         llt = self._llt
         if not self._redundant:
-            return J.T @ llt.solve(x)
+            solved: FloatArray = llt.solve(x)  # eigenpy: untyped
+            return J.T @ solved
         pull = (self._gain_posture - self._ns_gain * q_arr) * scale
-        dq_arr = J.T @ llt.solve(x - J @ pull)
+        solved = llt.solve(x - J @ pull)
+        dq_arr = J.T @ solved
         dq_arr += pull
         return dq_arr
 
-    def singularity_slowdown(self, g: Geometry, x: np.ndarray) -> float:
+    def singularity_slowdown(self, g: Geometry, x: FloatArray) -> float:
         """Speed scale for the weighted root-axes twist `x` at `g`: below 1 only if the condition number
         grows along the joint motion for `x` (predicted by a finite difference), so backing out is never
         slowed. Past the threshold this moves the model's data (`g` is then recomputed when next asked)."""
@@ -148,7 +151,7 @@ class DampedSolver:
             return singularity_scale(condition, self._threshold, self._hard_stop, toward)
         return 1.0
 
-    def _predicted_condition(self, q: np.ndarray, dq: np.ndarray) -> float:
+    def _predicted_condition(self, q: FloatArray, dq: FloatArray) -> float:
         """Condition number a small step along `dq` would give (overwrites the model's data)."""
         norm = max(map(abs, dq.tolist()))
         if norm == 0.0:
@@ -179,4 +182,5 @@ class DampedSolver:
         if np.max(np.abs(correction)) > _STRAIGHTEN_LIMIT * np.max(np.abs(dq_arr)):
             return dq  # not second order: a step too long for one Newton step to be right
         dq_arr -= correction
-        return dq_arr.tolist()
+        straightened: list[float] = dq_arr.tolist()
+        return straightened

@@ -37,6 +37,7 @@ from collections.abc import Sequence
 
 import numpy as np
 import pinocchio as pin
+from compliant_common.typedefs import FloatArray
 
 from jog_arm.command_frames import CommandFrames
 from jog_arm.command_state import CommandResult, CommandState
@@ -135,7 +136,7 @@ class JogCalcs:
         self._filter = LowPassFilter(settings.low_pass_filter_coeff, 6)  # on the twist
         self._x_filtered = np.zeros(6)
         self._from_commanded = settings.integrate_from == "commanded"
-        posture: np.ndarray | None = None  # model order; None: where motion starts
+        posture: FloatArray | None = None  # model order; None: where motion starts
         if settings.nullspace_posture:
             if len(settings.nullspace_posture) != n:
                 raise SettingsError(
@@ -181,7 +182,7 @@ class JogCalcs:
         """True if commands in frame `name` can be resolved (model frame or added with :meth:`add_frame`)."""
         return self.command_frames.resolve(name) is not None
 
-    def add_frame(self, name: str, parent: str, rotation: np.ndarray) -> None:
+    def add_frame(self, name: str, parent: str, rotation: FloatArray) -> None:
         """Makes a frame the model does not know usable for commands, fixed relative to a model frame
         (see `CommandFrames.add`).
 
@@ -307,7 +308,7 @@ class JogCalcs:
         out.message = message
         return out
 
-    def _start_running(self, q_arr: np.ndarray) -> None:
+    def _start_running(self, q_arr: FloatArray) -> None:
         if not self._running:
             self._running = True
             self.solver.start_motion(q_arr)

@@ -23,6 +23,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pinocchio as pin
 from compliant_common.errors import StackError
+from compliant_common.typedefs import FloatArray
 
 from jog_arm.settings import JointLimitOverride
 
@@ -145,11 +146,11 @@ class ArmModel:
 
     # --- queries -------------------------------------------------------------------------------------
 
-    def neutral(self) -> np.ndarray:
+    def neutral(self) -> FloatArray:
         """Neutral (all zero) configuration of the controlled joints, one angle each, a fresh array."""
         return np.zeros(self.nv)
 
-    def pin_q(self, q: Sequence[float] | np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    def pin_q(self, q: Sequence[float] | FloatArray, out: FloatArray | None = None) -> FloatArray:
         """Pinocchio configuration for the joint values `q` (one per joint, model order).
 
         Args:
@@ -172,7 +173,7 @@ class ArmModel:
             buf[iq + 1] = math.sin(angle)
         return buf
 
-    def angles(self, q_pin: np.ndarray) -> np.ndarray:
+    def angles(self, q_pin: FloatArray) -> FloatArray:
         """Joint values (one per joint, angles in (-pi, pi] for continuous joints) of a Pinocchio `q_pin`."""
         values = np.empty(self.nv)
         for iq, iv in self._single:
@@ -193,30 +194,35 @@ class ArmModel:
         """
         if not self.has_frame(name):
             raise KinematicsError(f"{name!r} is not a frame of the robot model")
-        return self.model.getFrameId(name)
+        fid: int = self.model.getFrameId(name)  # pinocchio: untyped
+        return fid
 
     def moves_with_tip_chain(self, frame_id: int) -> bool:
         """True if the frame's placement is refreshed by :meth:`jacobian` (root or on the tip's chain)."""
         return self.model.frames[frame_id].parentJoint in self._tip_support
 
-    def jacobian(self, q: np.ndarray) -> np.ndarray:
+    def jacobian(self, q: FloatArray) -> FloatArray:
         """Tip Jacobian (6 x nv, linear rows first, LOCAL_WORLD_ALIGNED) at `q`.
 
         Also refreshes the placements of the joints on the tip's chain and of the tip frame in `self.data`.
         """
         q_pin = self.pin_q(q, self._q_pin)
-        return pin.computeFrameJacobian(self.model, self.data, q_pin, self.tip_id, pin.LOCAL_WORLD_ALIGNED)
+        J: FloatArray = pin.computeFrameJacobian(
+            self.model, self.data, q_pin, self.tip_id, pin.LOCAL_WORLD_ALIGNED
+        )
+        return J
 
-    def frame_rotation(self, frame_id: int, q: np.ndarray | None = None) -> np.ndarray:
+    def frame_rotation(self, frame_id: int, q: FloatArray | None = None) -> FloatArray:
         """Rotation of a frame in the root frame, after :meth:`jacobian` (or at `q` if given).
 
         Frames off the tip's chain need `q` (a full forward kinematics), unless fixed to the root.
         """
         if q is not None:
             pin.forwardKinematics(self.model, self.data, self.pin_q(q, self._q_pin))
-        return pin.updateFramePlacement(self.model, self.data, frame_id).rotation
+        rotation: FloatArray = pin.updateFramePlacement(self.model, self.data, frame_id).rotation
+        return rotation
 
-    def frame_pose(self, q: np.ndarray, frame: str, relative_to: str = "") -> pin.SE3:
+    def frame_pose(self, q: FloatArray, frame: str, relative_to: str = "") -> pin.SE3:
         """Pose of `frame` in `relative_to` (the root frame if empty) at configuration `q`.
 
         Raises:
@@ -232,8 +238,8 @@ class ArmModel:
 
 
     def tip_displacement(
-        self, q_from: Sequence[float] | np.ndarray, q_to: Sequence[float] | np.ndarray, out: np.ndarray
-    ) -> np.ndarray:
+        self, q_from: Sequence[float] | FloatArray, q_to: Sequence[float] | FloatArray, out: FloatArray
+    ) -> FloatArray:
         """The tip's displacement from `q_from` to `q_to` (model order) into `out` (6): translation, then
         rotation vector, both in root axes: what a LOCAL_WORLD_ALIGNED tip twist held constant integrates to.
         Uses data of its own (the cycle's data keeps its placements)."""
@@ -247,7 +253,7 @@ class ArmModel:
         out[3:] = pin.log3(end.rotation @ R0.T)
         return out
 
-    def measured_pose(self, q: Sequence[float], frame_id: int, base_id: int) -> np.ndarray:
+    def measured_pose(self, q: Sequence[float], frame_id: int, base_id: int) -> FloatArray:
         """4x4 pose of frame `frame_id` in frame `base_id` at `q` (model order).
 
         Forward kinematics runs once per `q` object: several frames asked at the same state share it.
@@ -259,7 +265,8 @@ class ArmModel:
         pose = pin.updateFramePlacement(self.model, data, frame_id)
         if base_id != 0:  # frame 0 is the root ("universe")
             pose = pin.updateFramePlacement(self.model, data, base_id).actInv(pose)
-        return pose.homogeneous
+        homogeneous: FloatArray = pose.homogeneous
+        return homogeneous
 
 
 def _chain_joints(model: pin.Model, tip_frame: str) -> list[str]:

@@ -14,6 +14,7 @@ import operator
 from collections.abc import Sequence
 
 import numpy as np
+from compliant_common.typedefs import FloatArray
 
 __all__ = ["JointLimiter", "singularity_scale"]
 
@@ -60,10 +61,10 @@ class JointLimiter:
 
     def __init__(
         self,
-        lower: Sequence[float] | np.ndarray,
-        upper: Sequence[float] | np.ndarray,
-        max_velocity: Sequence[float] | np.ndarray,
-        max_acceleration: Sequence[float] | np.ndarray,
+        lower: Sequence[float] | FloatArray,
+        upper: Sequence[float] | FloatArray,
+        max_velocity: Sequence[float] | FloatArray,
+        max_acceleration: Sequence[float] | FloatArray,
         margin: float,
         slowdown_width: float,
         period: float,

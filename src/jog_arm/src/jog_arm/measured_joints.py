@@ -11,6 +11,7 @@ import operator
 from collections.abc import Sequence
 
 import numpy as np
+from compliant_common.typedefs import FloatArray
 
 from jog_arm.kinematics import ArmModel
 
@@ -113,7 +114,7 @@ class MeasuredJoints:
             return tuple(values)
         return tuple([values[i] for i in self._to_user_list])
 
-    def model_order(self, values: Sequence[float]) -> np.ndarray:
+    def model_order(self, values: Sequence[float]) -> FloatArray:
         """User-order `values` as a new model-order array."""
         q = np.empty(self.nv)
         q[self.to_user] = np.asarray(values, dtype=float)

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import sys
 import threading
-from typing import Any
 
 import rospy
 from compliant_common.master import MasterWatch
@@ -40,7 +39,7 @@ class JogArmNode:
         self.ros = JogArmRos(self.stage, self._lock)
         # A clock that stops (a dead /clock source) is a fault too: commands would never turn stale.
         self._clock = JumpAwareClock(stop_tolerance=max(0.5, 2.0 * settings.incoming_cmd_timeout))
-        fast: dict[str, Any] = {"queue_size": 1, "tcp_nodelay": True}
+        fast: dict[str, object] = {"queue_size": 1, "tcp_nodelay": True}
         self._subs = [
             rospy.Subscriber(settings.joint_topic, JointState, self._on_joints, **fast),
             rospy.Subscriber(settings.cmd_in_topic, TwistStamped, self._on_twist, **fast),

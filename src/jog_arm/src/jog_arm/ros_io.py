@@ -8,14 +8,14 @@ from __future__ import annotations
 
 import threading
 import time
-from typing import Any
 
 import pinocchio as pin
 import rospy
 import tf2_ros
+from compliant_common.typedefs import ParamMap
 from compliant_control_msgs.msg import JogStatus
 from std_msgs.msg import Float64MultiArray
-from std_srvs.srv import Trigger, TriggerResponse
+from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from jog_arm.settings import JogSettings, SettingsError
@@ -47,7 +47,7 @@ class JogArmRos:
         self._throttled: dict[str, float] = {}
         self.closed = False
         queue = None if s.publish_synchronously else 1  # None: no sender thread, see the README
-        self._cmd_msg: Any
+        self._cmd_msg: JointTrajectory | Float64MultiArray
         if s.command_out_type == "trajectory":
             self._cmd_msg = JointTrajectory(joint_names=stage.joint_names)
             self._cmd_pub = rospy.Publisher(s.cmd_out_topic, JointTrajectory, queue_size=queue,
@@ -148,7 +148,7 @@ class JogArmRos:
                       "fixed)", frame, self._s.planning_frame)
 
     # --- services ---
-    def _on_pause(self, _req: Any) -> TriggerResponse:
+    def _on_pause(self, _req: TriggerRequest) -> TriggerResponse:
         """Pauses and answers once the arm is at rest and the halt commands are out, so that the caller
         (named_poses before a trajectory) can use the driver at once: nothing of jog_arm's follows."""
         with self._lock:
@@ -168,11 +168,11 @@ class JogArmRos:
         return TriggerResponse(success=True, message=(
             f"paused: still stopping after {PAUSE_WAIT:g} s; commands ignored until ~resume"))
 
-    def _on_resume(self, _req: Any) -> TriggerResponse:
+    def _on_resume(self, _req: TriggerRequest) -> TriggerResponse:
         with self._lock:
             return TriggerResponse(success=True, message=self._stage.resume())
 
-    def _on_cycle_stats(self, _req: Any) -> TriggerResponse:
+    def _on_cycle_stats(self, _req: TriggerRequest) -> TriggerResponse:
         """Cycle timing since the previous call (or start), then starts a new window."""
         with self._lock:
             return TriggerResponse(success=True, message=self._stage.cycle_stats())
@@ -189,7 +189,7 @@ class JogArmRos:
         self._status_pub.unregister()
 
 
-def load(params: dict[str, Any], urdf_xml: str | None, prefix: str) -> tuple[JogSettings, list[str]]:
+def load(params: ParamMap, urdf_xml: str | None, prefix: str) -> tuple[JogSettings, list[str]]:
     """Validates the parameters and the presence of a robot description (no ROS calls).
 
     Raises:

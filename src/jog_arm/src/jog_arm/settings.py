@@ -9,10 +9,10 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, fields
-from typing import Any
 
 from compliant_common.errors import StackError
 from compliant_common.schema import SchemaError, param, schema_of
+from compliant_common.typedefs import ParamMap
 
 __all__ = [
     "COMMAND_IN_TYPES",
@@ -69,15 +69,15 @@ class JointLimitOverride:
     max_acceleration: float | None = None
 
 
-def _pos(default: float, unit: str, doc: str) -> Any:
+def _pos(default: float, unit: str, doc: str) -> float:
     return param(default, unit=unit, gt=0.0, doc=doc)
 
 
-def _nonneg(default: float, unit: str, doc: str) -> Any:
+def _nonneg(default: float, unit: str, doc: str) -> float:
     return param(default, unit=unit, ge=0.0, doc=doc)
 
 
-def _topic(default: str, doc: str = "") -> Any:
+def _topic(default: str, doc: str = "") -> str:
     return param(default, nonempty=True, doc=doc)
 
 
@@ -213,7 +213,7 @@ class JogSettings:
     )
 
     @classmethod
-    def from_params(cls, params: Mapping[str, Any], prefix: str = "jog_arm_server/") -> JogSettings:
+    def from_params(cls, params: ParamMap, prefix: str = "jog_arm_server/") -> JogSettings:
         """Builds and validates settings from a parameter dictionary.
 
         Args:
@@ -232,12 +232,12 @@ class JogSettings:
 
     @classmethod
     def from_params_with_warnings(
-        cls, params: Mapping[str, Any], prefix: str = "jog_arm_server/"
+        cls, params: ParamMap, prefix: str = "jog_arm_server/"
     ) -> tuple[JogSettings, list[str]]:
         """Like :meth:`from_params`, also returning warnings about renamed keys (MoveIt Servo's)."""
         flat = flatten_params(params)
         warnings: list[str] = []
-        given: dict[str, Any] = {}
+        given: dict[str, object] = {}
         for key in sorted(flat):
             base = key.split("/")[0]
             if key in PARAMETERS or key in _NODE_ONLY or key.startswith("joint_limits/"):
@@ -254,7 +254,7 @@ class JogSettings:
         except SchemaError as err:
             raise SettingsError(_message(prefix, err)) from None
         values["joint_limits"] = _read_joint_limits(given, prefix)
-        settings = cls(**PARAMETERS.attrs(values))
+        settings = PARAMETERS.build(cls, values)
         settings.validate(prefix)
         return settings, warnings
 
@@ -303,9 +303,9 @@ def _message(prefix: str, err: SchemaError) -> str:
     return f"{prefix}{err.key}: {err.message}"
 
 
-def flatten_params(params: Mapping[str, Any], base: str = "") -> dict[str, Any]:
+def flatten_params(params: ParamMap, base: str = "") -> dict[str, object]:
     """Flattens nested parameter dictionaries into "a/b" keys (flat keys pass through)."""
-    flat: dict[str, Any] = {}
+    flat: dict[str, object] = {}
     for key, value in params.items():
         name = f"{base}{str(key).strip('/')}"
         if isinstance(value, Mapping) and name != "joint_limits" and not name.startswith("joint_limits/"):
@@ -318,7 +318,7 @@ def flatten_params(params: Mapping[str, Any], base: str = "") -> dict[str, Any]:
     return flat
 
 
-def _read_joint_limits(flat: Mapping[str, Any], prefix: str) -> dict[str, JointLimitOverride]:
+def _read_joint_limits(flat: ParamMap, prefix: str) -> dict[str, JointLimitOverride]:
     limits: dict[str, JointLimitOverride] = {}
     allowed = {f.name for f in fields(JointLimitOverride)}
     for key, value in flat.items():

@@ -16,7 +16,8 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Sequence
-from typing import Any
+
+from compliant_common.typedefs import FloatArray
 
 from jog_arm.contact_guard import ContactGuard
 from jog_arm.jog_calcs import JogCalcs, JogOutput
@@ -290,7 +291,7 @@ class JogStage:
     def knows_frame(self, frame: str) -> bool:
         return self.jog.has_frame(frame)
 
-    def add_frame(self, frame: str, parent: str, rotation: Any) -> None:
+    def add_frame(self, frame: str, parent: str, rotation: FloatArray) -> None:
         """A frame the model lacks, fixed relative to the model frame `parent` (e.g. looked up in tf)."""
         self.jog.add_frame(frame, parent, rotation)
 

@@ -130,7 +130,7 @@ class TeleopSettings:
             values = PARAMETERS.load(params, prefix="~")
         except SchemaError as err:
             raise TeleopSettingsError(err.key, err.message) from None
-        settings = cls(**PARAMETERS.attrs(values))
+        settings = PARAMETERS.build(cls, values)
         warnings: list[str] = []
         if settings.key_timeout <= TYPICAL_REPEAT_DELAY:
             warnings.append(

@@ -53,6 +53,6 @@ def load_settings(params: Mapping[str, Any]) -> GuiSettings:
         ValueError: An unknown key (naming the closest valid one) or a bad value, naming the key.
     """
     try:
-        return GuiSettings(**PARAMETERS.attrs(PARAMETERS.load(params, prefix="~")))
+        return PARAMETERS.build(GuiSettings, PARAMETERS.load(params, prefix="~"))
     except SchemaError as err:
         raise ValueError(err.named("~")) from None

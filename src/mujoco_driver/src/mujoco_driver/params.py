@@ -129,11 +129,11 @@ class DriverSettings:
             DriverParamError: Naming the first bad key, or an unknown key and the closest valid one.
         """
         try:
-            values = PARAMETERS.attrs(PARAMETERS.load(params, prefix="~"))
+            values = PARAMETERS.load(params, prefix="~")
         except SchemaError as err:
             raise DriverParamError(err.named("~")) from None
-        values.setdefault("publish_clock", bool(use_sim_time))
-        settings = cls(**values)
+        values.setdefault("publish_clock", bool(use_sim_time))  # the key is the attribute's name
+        settings = PARAMETERS.build(cls, values)
         settings.validate()
         return settings
 

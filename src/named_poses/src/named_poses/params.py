@@ -83,6 +83,6 @@ def load_settings(params: Mapping[str, Any]) -> NamedPoseSettings:
         ValueError: An unknown key (naming the closest valid one) or a bad value, naming the key.
     """
     try:
-        return NamedPoseSettings(**PARAMETERS.attrs(PARAMETERS.load(params, prefix="~")))
+        return PARAMETERS.build(NamedPoseSettings, PARAMETERS.load(params, prefix="~"))
     except SchemaError as err:
         raise ValueError(err.named("~")) from None
