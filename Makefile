@@ -4,6 +4,7 @@ SHELL := /bin/bash
 ROBOT ?= ur5
 DRIVER ?=
 DRIVER_OPTIONS ?=
+HARDWARE_ARGS ?=
 BAG ?=
 ENV := scripts/with_env
 PYTEST_ARGS ?=
@@ -30,7 +31,8 @@ param-tables: build
 
 demo: build
 	@$(ENV) python scripts/demo --robot $(ROBOT) $(if $(DRIVER),--driver $(DRIVER)) \
-		$(if $(DRIVER_OPTIONS),--driver-options "$(DRIVER_OPTIONS)") $(if $(BAG),--bag)
+		$(if $(DRIVER_OPTIONS),--driver-options "$(DRIVER_OPTIONS)") \
+		$(if $(HARDWARE_ARGS),--hardware-args "$(HARDWARE_ARGS)") $(if $(BAG),--bag)
 
 # make robot NAME=<name> URDF=<path, or relative to example-robot-data's robots/> TIP=<flange link>
 #   [BASE=<link>] [TOOL_MASS=<kg>] [DRIVER=<mujoco_driver profile name or YAML path>]: writes

@@ -55,13 +55,13 @@ CELLS = {
 
 
 @contextlib.contextmanager
-def _cell(robot: str, profile: str, joints: str):
+def _cell(robot: str, profile: str, joints: str, hardware_args: dict[str, str] | None = None):
     """The emulated driver first (``profile`` "": the generic interface), then the robot package's
-    hardware.launch, unchanged (no arguments)."""
+    hardware.launch, unchanged (no arguments but ``hardware_args``, a documented option)."""
     args = {"robot_package": robot, **({"profile": profile} if profile else {})}
     with run_launch("mujoco_driver", "emulated_robot.launch", args=args) as driver:
         driver.wait_for_topic(joints, timeout=40)
-        with run_launch(robot, "hardware.launch") as stack:
+        with run_launch(robot, "hardware.launch", args=hardware_args or {}) as stack:
             # named_poses is a node of its own: its service comes up on its own schedule (CI once called
             # move_to before it was advertised: "no provider").
             for service in ("/configure_cartesian_impedance", "/named_poses/move_to"):
@@ -150,16 +150,16 @@ def _controller_states(rospy, profile: DriverProfile) -> dict[str, str]:
 
 def _switch_on_jog_controller(rospy, driver, twist_pub, pose: Collector, base: str, robot: str,
                               profile: DriverProfile) -> str:
-    """The controller jog_arm commands (``cmd_out_topic`` of the package's jog_arm_hardware.yaml) is one of
-    the profile's. If the driver starts it not running, as ur_robot_driver its velocity controller, jog_arm's
-    commands are ignored (the arm stays put, the driver names the controller) until the user switches it on
-    through controller_manager/switch_controller, stopping the running controllers that command the joints
-    (a resource conflict otherwise). Returns what was done, in words."""
-    jog = yaml.safe_load((SRC / robot / "config/jog_arm_hardware.yaml").read_text())
-    name = jog["cmd_out_topic"].strip("/").rsplit("/command", 1)[0]
+    """The controller jog_arm commands (its ``cmd_out_topic``, from the package's jog_arm_hardware*.yaml) is
+    one of the profile's. If the driver starts it not running, as ur_robot_driver its velocity controller,
+    jog_arm's commands are ignored (the arm stays put, the driver names the controller) until the user
+    switches it on through controller_manager/switch_controller, stopping the running controllers that command
+    the joints (a resource conflict otherwise). Returns what was done, in words."""
+    topic = rospy.get_param("/jog_arm_server/cmd_out_topic")  # as hardware.launch loaded it
+    name = topic.strip("/").rsplit("/command", 1)[0]
     specs = {c.name: c for c in profile.controllers}
     assert name in specs and specs[name].command != "none", (
-        f"jog_arm commands {jog['cmd_out_topic']}: not a command controller of {profile.driver}")
+        f"jog_arm commands {topic}: not a command controller of {profile.driver}")
     states = _controller_states(rospy, profile)
     assert states == {c.name: c.initial_state for c in profile.controllers}
     if states[name] == "running":
@@ -235,16 +235,23 @@ def _jog_and_push(rospy, robot: str, cell: dict, profile: DriverProfile | None, 
     return switched
 
 
-@pytest.mark.parametrize("robot", ["ur5_custom", "panda_custom"])
-def test_hardware_launch_runs_unchanged_against_the_emulated_driver(ros_node, robot):
+@pytest.mark.parametrize(("robot", "hardware_args"), [
+    ("ur5_custom", {}),
+    ("panda_custom", {}),
+    # franka_hw's VelocityJointInterface: jog_arm streams to joint_group_velocity_controller, which the user
+    # switches on (panda_custom README, "Velocity interface"); named_poses switches its trajectory controller.
+    ("panda_custom", {"command_interface": "velocity"}),
+])
+def test_hardware_launch_runs_unchanged_against_the_emulated_driver(ros_node, robot, hardware_args):
     rospy = ros_node
     cell = CELLS[robot]
     profile = load_profile(cell["profile"])
-    with _cell(robot, cell["profile"], cell["joints"]) as (driver, _stack), _clients(rospy) as clients:
+    with (_cell(robot, cell["profile"], cell["joints"], hardware_args) as (driver, _stack),
+          _clients(rospy) as clients):
         switched = _jog_and_push(rospy, robot, cell, profile, driver, clients)
-        print(f"\n{robot} as {cell['profile']} ({switched}): jogged 2 cm along -X; the follower gave way to "
-              "10 N pushes along -X and +Y")
-        if profile.reflex is not None:
+        print(f"\n{robot} as {cell['profile']} {hardware_args} ({switched}): jogged 2 cm along -X; the "
+              "follower gave way to 10 N pushes along -X and +Y")
+        if profile.reflex is not None and not hardware_args:  # the driver's reflex, whatever the interface
             # Over the collision threshold (franka's 20 N): the reflex stops the arm until error recovery.
             pose, _cc_status, twist_pub = clients
             mode = Collector("/mujoco_driver/robot_mode", String)
