@@ -92,7 +92,8 @@ def test_each_command_controller_has_its_topic_and_the_callback_learns_its_name(
         assert topics == {"scaled_pos_joint_traj_controller/command": JointTrajectory,
                           "joint_group_vel_controller/command": Float64MultiArray}
     else:
-        assert topics == {"position_joint_trajectory_controller/command": JointTrajectory}
+        assert topics == {"position_joint_trajectory_controller/command": JointTrajectory,
+                          "joint_group_velocity_controller/command": Float64MultiArray}
     for name, sub in graph.subscribers.items():
         assert sub.kwargs == {"queue_size": 1, "tcp_nodelay": True}
         sub.callback(sub.data_class())
@@ -120,8 +121,9 @@ def test_controllers_are_listed_and_switched_through_the_services(sim, robot, gr
     listed = graph.services["controller_manager/list_controllers"].handler(None).controller
     states = {c.name: c.state for c in listed}
     if robot.package != "ur5_custom":
-        assert states == dict.fromkeys(["franka_state_controller", "position_joint_trajectory_controller"],
-                                       "running")
+        assert states == {"franka_state_controller": "running",
+                          "position_joint_trajectory_controller": "running",
+                          "joint_group_velocity_controller": "initialized"}
         return
     assert states["joint_group_vel_controller"] == "initialized"
     assert "joint_group_vel_controller is initialized" in driver.refusal("joint_group_vel_controller")

@@ -8,12 +8,14 @@ from collections.abc import Callable
 from typing import TypeAlias
 
 import rospy
-from rospy.timer import TimerEvent
 
 from compliant_common.clock import ClockJump, ClockWatch
 from compliant_common.rospy_internals import is_wallclock
 
-__all__ = ["JumpAwareClock", "MonotonicTimer", "TimerCallback", "timer"]
+__all__ = ["JumpAwareClock", "MonotonicTimer", "TimerCallback", "TimerEvent", "timer"]
+
+#: rospy's timer event (public rospy.timer API; named here once for annotations).
+TimerEvent: TypeAlias = rospy.timer.TimerEvent
 
 #: A timer's callback: gets rospy's `TimerEvent`, or None from a `MonotonicTimer`.
 TimerCallback: TypeAlias = Callable[[TimerEvent | None], None]

@@ -19,11 +19,10 @@ from cartesian_impedance_msgs.srv import (
     ConfigureForceControlRequest,
     ConfigureForceControlResponse,
 )
-from compliant_common.ros_time import timer
+from compliant_common.ros_time import TimerEvent, timer
 from compliant_control_msgs.msg import AxisState, ContactControlStatus
 from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsRequest, ConfigureLawsResponse
 from geometry_msgs.msg import TwistStamped, WrenchStamped
-from rospy.timer import TimerEvent
 from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 
 from contact_control.axes import AXES, END_NAMES, EXCEEDED_ACTION_NAMES, LAW_NAMES, SAFETY_NAMES
