@@ -92,17 +92,22 @@ def solve_ik(
     q = np.array(seed, dtype=float)
     lo, hi = arm.lower + limit_margin, arm.upper - limit_margin
     for _ in range(iterations):
-        err = _pose_error(arm, q, goal)
-        if float(np.linalg.norm(err)) < IK_TOLERANCE:
+        jac = arm.jacobian(q)  # also places the tip frame: one kinematics pass per iteration
+        tip = arm.data.oMf[arm.tip_id]
+        err = np.concatenate([goal.translation - tip.translation, pin.log3(goal.rotation @ tip.rotation.T)])
+        norm = float(np.linalg.norm(err))
+        if norm < IK_TOLERANCE:
             return q
-        jac = arm.jacobian(q)
-        damping = 1e-6 + 1e-3 * min(1.0, float(np.linalg.norm(err)))
-        step = jac.T @ np.linalg.solve(jac @ jac.T + damping * np.eye(6), err)
+        damping = 1e-6 + 1e-3 * min(1.0, norm)
+        step = jac.T @ np.linalg.solve(jac @ jac.T + damping * _EYE6, err)
         biggest = float(np.max(np.abs(step)))
         if biggest > 0.5:  # far from the goal: no wild jumps across branches
             step *= 0.5 / biggest
-        q = np.clip(q + step, lo, hi)
+        q = np.minimum(np.maximum(q + step, lo), hi)
     return q if float(np.linalg.norm(_pose_error(arm, q, goal))) < IK_TOLERANCE else None
+
+
+_EYE6 = np.eye(6)
 
 
 @dataclass(frozen=True)
@@ -315,7 +320,12 @@ def find_start_pose(
                             continue
                         found.append(q)
                     for q in found:
-                        if condition_number(arm, q, length_scale) >= max_condition:
+                        condition = condition_number(arm, q, length_scale)
+                        if condition >= max_condition:
+                            continue
+                        # The score below is at least this (worst >= condition, the margin term >= -0.5):
+                        # a candidate that cannot beat the best so far is not analysed.
+                        if best is not None and condition + 2.0 * _off_centre(arm, q) - 0.5 >= best[0] - 1e-9:
                             continue
                         if lowest_joint(arm, q) < MIN_JOINT_HEIGHT:
                             continue
