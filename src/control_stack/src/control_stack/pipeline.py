@@ -27,7 +27,7 @@ from contact_control.stage import ZERO, Answer, ContactStage, PoseSource, Veloci
 from jog_arm.settings import JogSettings
 from jog_arm.stage import JogCycle, JogStage
 
-__all__ = ["CompliantPipeline", "PipelineOutput", "PipelineStatus"]
+__all__ = ["NOTHING", "CompliantPipeline", "PipelineOutput", "PipelineStatus"]
 
 ECHOES_KEPT = 16  # own twists remembered to recognise their copies coming back over the topic
 
@@ -40,19 +40,24 @@ class PipelineStatus(NamedTuple):
     jog: JogCycle | None
 
 
-class PipelineOutput:
-    """What one call produced. One instance per pipeline, refilled by each call.
+class PipelineOutput(NamedTuple):
+    """What one call produced: a new one per call (immutable), or `NOTHING`.
 
     Attributes:
         twist: contact_control's twist (velocity_command_frame) to publish for observers, or None.
         cycle: The jog cycle that ran (its joint command if `cycle.publish`), or None.
     """
 
-    __slots__ = ("cycle", "twist")
+    twist: Velocity | None
+    cycle: JogCycle | None
 
-    def __init__(self) -> None:
-        self.twist: Velocity | None = None
-        self.cycle: JogCycle | None = None
+
+#: A call that produced nothing (shared: no allocation for the calls that mostly produce nothing).
+NOTHING = PipelineOutput(None, None)
+
+
+def _output(twist: Velocity | None, cycle: JogCycle | None) -> PipelineOutput:
+    return NOTHING if twist is None and cycle is None else PipelineOutput(twist, cycle)
 
 
 class CompliantPipeline:
@@ -91,7 +96,6 @@ class CompliantPipeline:
         self._twist_frame = contact.velocity_command_frame
         self._clock = ClockWatch(stop_tolerance=max(0.5, 2.0 * jog.incoming_cmd_timeout))
         self._sent: collections.deque[tuple[float, Velocity]] = collections.deque(maxlen=ECHOES_KEPT)
-        self._out = PipelineOutput()
         # The model frames a wrench will ask for, computed when the joint state arrives (off the wrench path).
         self._warm = sorted(f for f in self.contact.frames_used if self.jog.frames.has(f, self._fixed))
 
@@ -126,22 +130,19 @@ class CompliantPipeline:
         out = self._check_clock(t)
         if out.twist is not None:  # the clock jumped: this wrench belongs to the old time
             return out
-        self._to_jog(self.contact.on_wrench(wrench, frame, stamp, t), t, out)
-        return out
+        return self._to_jog(self.contact.on_wrench(wrench, frame, stamp, t), t, out)
 
     def from_contact(self, twist: Velocity | None, t: float) -> PipelineOutput:
         """A twist contact_control made outside a wrench or a tick (a stop request's zero), for jog_arm."""
-        out = self._out
-        out.twist = out.cycle = None
-        self._to_jog(twist, t, out)
-        return out
+        return self._to_jog(twist, t, NOTHING)
 
-    def _to_jog(self, twist: Velocity | None, t: float, out: PipelineOutput) -> None:
-        """contact_control's twist (if any) -> jog_arm, as an inside command (no contact guard)."""
-        if twist is not None:
-            self._sent.append((t, twist))
-            out.twist = twist
-            out.cycle = self.jog.on_twist(twist, self._twist_frame, t, outside=False)
+    def _to_jog(self, twist: Velocity | None, t: float, out: PipelineOutput) -> PipelineOutput:
+        """contact_control's twist (if any) -> jog_arm, as an inside command (no contact guard): the output
+        with this twist and the cycle it ran (None if none); `out` unchanged without a twist."""
+        if twist is None:
+            return out
+        self._sent.append((t, twist))
+        return PipelineOutput(twist, self.jog.on_twist(twist, self._twist_frame, t, outside=False))
 
     def on_twist(
         self, twist: Sequence[float], frame: str, stamp: float, t: float
@@ -154,8 +155,7 @@ class CompliantPipeline:
         out = self._check_clock(t)
         if self._is_echo(twist, stamp):
             return out
-        out.cycle = self.jog.on_twist(twist, frame, t, outside=True)
-        return out
+        return _output(out.twist, self.jog.on_twist(twist, frame, t, outside=True))
 
     def _is_echo(self, twist: Sequence[float], stamp: float) -> bool:
         """Whether `twist` is one this pipeline sent: same values, stamped within 1 us of one it made."""
@@ -176,10 +176,10 @@ class CompliantPipeline:
         cycle due (a fixed-rate cycle, or a gap fill between twists)."""
         out = self._check_clock(t)
         if t >= self.contact.next_due():
-            self._to_jog(self.contact.tick(t), t, out)
+            out = self._to_jog(self.contact.tick(t), t, out)
         cycle = self.jog.tick(t)
         if cycle is not None:
-            out.cycle = cycle
+            out = PipelineOutput(out.twist, cycle)
         return out
 
     def prepare(self) -> None:
@@ -189,16 +189,14 @@ class CompliantPipeline:
         self.jog.prepare()
 
     def _check_clock(self, t: float) -> PipelineOutput:
-        """Resets the output; on a clock jump both stages stop (the zero twist is in `twist`)."""
-        out = self._out
-        out.twist = out.cycle = None
+        """`NOTHING`, or on a clock jump what stopping both stages produced (the zero twist in `twist`)."""
         jump = self._clock.observe(t, self._monotonic())
-        if jump is not None:
-            note = jump.describe()
-            self.jog.clock_jumped(note)
-            self._sent.clear()
-            self._to_jog(self.contact.clock_jumped(note, t) or ZERO, t, out)
-        return out
+        if jump is None:
+            return NOTHING
+        note = jump.describe()
+        self.jog.clock_jumped(note)
+        self._sent.clear()
+        return self._to_jog(self.contact.clock_jumped(note, t) or ZERO, t, NOTHING)
 
     # --- requests and status ---
     def configure(
@@ -221,11 +219,9 @@ class CompliantPipeline:
     # --- master ---
     def master_lost(self, reason: str) -> PipelineOutput:
         """The graph is broken: the move ends, the jogger stops and refuses commands until `master_back`."""
-        out = self._out
-        out.cycle = None
-        out.twist = self.contact.master_lost(reason)
+        twist = self.contact.master_lost(reason)
         self.jog.suspend(reason)
-        return out
+        return _output(twist, None)
 
     def master_back(self) -> None:
         self.contact.master_back()

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import NamedTuple
 
 import numpy as np
 import pinocchio as pin
@@ -49,34 +50,42 @@ from jog_arm.measured_joints import MeasuredJoints
 from jog_arm.settings import JogSettings, SettingsError
 from jog_arm.status import StatusCode, motion_status
 
-__all__ = ["CommandResult", "JogCalcs", "JogOutput"]
+__all__ = ["CommandResult", "JogCalcs", "JogOutput", "Point"]
+
+Point = tuple[tuple[float, ...], tuple[float, ...], float]  # positions, velocities, time_from_start [s]
 
 
-class JogOutput:
-    """Result of one cycle. One instance per :class:`JogCalcs`, refilled every cycle (its tuples stay valid).
+class JogOutput(NamedTuple):
+    """Result of one cycle: a new one per :meth:`JogCalcs.step` (immutable; its tuples are its own).
 
     Attributes:
-        positions: Joint positions of the next point [rad], in `JogCalcs.joint_names` order (a tuple).
-        velocities: Joint velocities [rad/s], same order (a tuple).
         publish: Whether the node should publish this cycle (False before the first command and after
             the final zero command has been repeated).
+        positions: Joint positions of the next point [rad], in `JogCalcs.joint_names` order.
+        velocities: Joint velocities [rad/s], same order.
         status: Why the output is what it is.
         message: Human-readable detail of `status`.
-        condition_number: Of the tip Jacobian at the reference configuration (last computed).
+        condition_number: Of the tip Jacobian at the reference configuration (last computed; NaN before
+            the first).
         speed_scale: Product of the singularity, joint-limit and velocity scales applied to the command
             (0 when there is nothing to follow).
     """
 
-    __slots__ = ("condition_number", "message", "positions", "publish", "speed_scale", "status", "velocities")
+    publish: bool
+    positions: tuple[float, ...]
+    velocities: tuple[float, ...]
+    status: StatusCode
+    message: str
+    condition_number: float
+    speed_scale: float
 
-    def __init__(self, size: int) -> None:
-        self.positions: tuple[float, ...] = (0.0,) * size
-        self.velocities: tuple[float, ...] = (0.0,) * size
-        self.publish = False
-        self.status = StatusCode.NO_JOINT_STATE
-        self.message = "no joint state received yet"
-        self.condition_number = math.nan
-        self.speed_scale = 0.0
+
+def _jog_output(publish: bool, positions: tuple[float, ...], velocities: tuple[float, ...],
+                status: StatusCode, message: str, condition_number: float, speed_scale: float) -> JogOutput:
+    """`JogOutput(...)` in one allocation instead of two (and faster): calling the class with more than four
+    fields allocates the call's argument array as well."""
+    return tuple.__new__(JogOutput, (publish, positions, velocities, status, message, condition_number,
+                                     speed_scale))
 
 
 class JogCalcs:
@@ -155,7 +164,7 @@ class JogCalcs:
         self._filter_live = False
         self._zero_sent = settings.num_outgoing_halt_msgs_to_publish  # silent until the first command
         self._zeros = (0.0,) * n
-        self._out = JogOutput(n)
+        self._condition = math.nan  # of the last Jacobian computed by a step
 
     # --- inputs ---------------------------------------------------------------------------------------
 
@@ -260,16 +269,13 @@ class JogCalcs:
             now: Current time [s], same clock as the `now` given to :meth:`set_command`.
 
         Returns:
-            The shared :class:`JogOutput` (overwritten by the next call).
+            This cycle's :class:`JogOutput`.
         """
-        out = self._out
         joints = self.joints
         if not joints.received:
-            out.publish = False
-            out.status = StatusCode.NO_JOINT_STATE
-            out.message = "no joint state received yet"
-            out.speed_scale = 0.0
-            return out
+            zeros = self._zeros
+            return _jog_output(False, zeros, zeros, StatusCode.NO_JOINT_STATE, "no joint state received yet",
+                               self._condition, 0.0)
         # 1. Reference configuration (plain float lists: cheaper than numpy for 6-7 values).
         q_ref, resynced = self._reference()
         status, message = self.command.status(now, joints.time)
@@ -288,25 +294,21 @@ class JogCalcs:
         # 7. Integrate over the publish period.
         q_cmd = self._q_cmd = self._integrate(q_ref, dq_new)
 
-        out.condition_number = condition
+        self._condition = condition
         if follow:
             self._zero_sent = 0
             status, message = motion_status(condition, s_sing, s_pos, s_vel)
-            out.speed_scale = s_sing * s_pos * s_vel
+            speed_scale = s_sing * s_pos * s_vel
         else:
-            out.speed_scale = 0.0
+            speed_scale = 0.0
             if not any(dq_new):
                 self._zero_sent = 1
             if not message:
                 message = "stopping"
         if resynced:
             message += " (re-synced to the measured joint state: tracking error above max_tracking_error)"
-        out.positions = joints.user_order(q_cmd)
-        out.velocities = joints.user_order(dq_new)
-        out.publish = True
-        out.status = status
-        out.message = message
-        return out
+        return _jog_output(True, joints.user_order(q_cmd), joints.user_order(dq_new), status, message,
+                           condition, speed_scale)
 
     def _start_running(self, q_arr: FloatArray) -> None:
         if not self._running:
@@ -344,9 +346,13 @@ class JogCalcs:
         return solver.solve(J, xf, q_arr, s_sing).tolist(), condition, s_sing
 
     def _integrate(self, q_ref: list[float], dq: list[float]) -> list[float]:
-        """Stage 7: positions = reference + velocity x pub_period."""
+        """Stage 7: positions = reference + velocity x pub_period (a copy filled in place: 3 allocations
+        where a comprehension over zip makes 7)."""
         period = self._period
-        return [q + v * period for q, v in zip(q_ref, dq, strict=True)]
+        q = q_ref.copy()
+        for i in range(self.nv):
+            q[i] += dq[i] * period
+        return q
 
     def prefetch(self) -> None:
         """Computes the next cycle's twist-independent part now (Jacobian, condition number, factorisation),
@@ -367,42 +373,36 @@ class JogCalcs:
 
     def _hold(self, q_ref: list[float], status: StatusCode, message: str) -> JogOutput:
         """Cycle at rest: repeat the zero command a few times, then fall silent."""
-        out = self._out
         self._filter_live = False
         if self._running:
             self._q_cmd = q_ref
         if self._zero_sent < self.settings.num_outgoing_halt_msgs_to_publish:
             self._zero_sent += 1
-            out.publish = True
+            publish = True
         else:
-            out.publish = False
+            publish = False
             self._running = False
-        out.positions = self.joints.user_order(q_ref)
-        out.velocities = self._zeros
-        out.status = status
-        out.message = message or "at rest"
-        out.speed_scale = 0.0
-        return out
+        return _jog_output(publish, self.joints.user_order(q_ref), self._zeros, status,
+                           message or "at rest", self._condition, 0.0)
 
     # --- outputs and queries --------------------------------------------------------------------------
 
-    def trajectory_points(self, count: int) -> list[tuple[tuple[float, ...], tuple[float, ...], float]]:
-        """Points (positions, velocities, time_from_start [s]) of the last output, for a JointTrajectory.
-
-        The first point is the cycle's output; later ones (simu mode) extrapolate at its velocity, kept
-        inside the position limits minus the margin, for controllers that drop points already in the past.
-        """
-        out = self._out
-        points = [(out.positions, out.velocities, self._period)]
-        if count > 1:
-            q = np.array(out.positions)
-            v = np.array(out.velocities)
-            lower = np.minimum(self.limiter.lower_stop[self._to_user], q)
-            upper = np.maximum(self.limiter.upper_stop[self._to_user], q)
-            for k in range(2, count + 1):
-                ahead = np.clip(q + v * (self._period * (k - 1)), lower, upper)
-                points.append((tuple(ahead.tolist()), out.velocities, self._period * k))
-        return points
+    def points_ahead(self, out: JogOutput, count: int) -> tuple[Point, ...]:
+        """Trajectory points 2..`count` (positions, velocities, time_from_start [s]) after `out`'s own point
+        (`out.positions`, `out.velocities`, `pub_period`), for a JointTrajectory: they extrapolate at its
+        velocity, kept inside the position limits minus the margin, for controllers that drop points already
+        in the past (simu mode)."""
+        if count < 2:
+            return ()
+        q = np.array(out.positions)
+        v = np.array(out.velocities)
+        lower = np.minimum(self.limiter.lower_stop[self._to_user], q)
+        upper = np.maximum(self.limiter.upper_stop[self._to_user], q)
+        return tuple(
+            (tuple(np.clip(q + v * (self._period * (k - 1)), lower, upper).tolist()), out.velocities,
+             self._period * k)
+            for k in range(2, count + 1)
+        )
 
     def eef_pose(self, positions: Sequence[float] | None = None) -> pin.SE3:
         """Pose of `ee_frame_name` in `planning_frame` at `positions` (user order) or the last reference."""

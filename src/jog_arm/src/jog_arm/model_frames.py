@@ -1,7 +1,7 @@
 """Poses of robot-model frames at the measured joint state (no tf needed in the same process).
 
 A controller that runs beside the jogger (contact_control in control_stack, jog_arm's contact guard) asks
-for a few frames per wrench; each answer is computed once per joint state.
+for a few frames per wrench; each answer is computed once per joint state (kept while the joints do not move).
 """
 
 from __future__ import annotations
@@ -44,7 +44,7 @@ class ModelFrames:
 
     def pose(self, frame: str, relative_to: str) -> Rows | None:
         """Pose (4x4 rows) of `frame` in `relative_to`; None if either is not a model frame. The rows are
-        shared until the next joint state: do not modify them.
+        shared until a joint state with other positions: do not modify them.
 
         Raises:
             LookupError: No joint state received yet.
@@ -55,8 +55,9 @@ class ModelFrames:
         q = self._measured()
         if q is None:
             raise LookupError("no joint state received yet")
-        if q is not self._q:  # a new joint state: earlier answers are out of date
-            self._poses.clear()
+        if q is not self._q:  # a new joint state: earlier answers are out of date unless it did not move
+            if q != self._q:
+                self._poses.clear()
             self._q = q
         key = (frame, relative_to)
         pose = self._poses.get(key)

@@ -72,7 +72,7 @@ class JogArmRos:
     # --- out ---
     def publish(self, cycle: JogCycle | None) -> None:
         """The cycle's joint command and status (status only while somebody listens); logs status changes.
-        Called with the node's lock held (the cycle and the messages are shared by its threads)."""
+        Called with the node's lock held (the messages are shared by its threads)."""
         if cycle is None or self.closed:
             return
         if cycle.publish:
@@ -84,7 +84,6 @@ class JogArmRos:
             msg.condition_number, msg.speed_scale = cycle.condition, cycle.scale
             self._status_pub.publish(msg)
         if cycle.status_changed:
-            cycle.status_changed = False
             level = log_level(cycle.status)
             log = rospy.logdebug if level == "debug" else rospy.loginfo if level == "info" else rospy.logwarn
             log("jog_arm_server: %s: %s", cycle.status.name, cycle.message)
@@ -96,10 +95,13 @@ class JogArmRos:
         else:
             # Stamp 0: "start now" for joint_trajectory_controller, whatever the transport delay.
             duration = rospy.Duration.from_sec
-            msg.points = [
+            points = [JointTrajectoryPoint(positions=cycle.positions, velocities=cycle.velocities,
+                                           time_from_start=duration(self._s.pub_period))]
+            points.extend(
                 JointTrajectoryPoint(positions=q, velocities=v, time_from_start=duration(t))
-                for q, v, t in cycle.points
-            ]
+                for q, v, t in cycle.ahead
+            )
+            msg.points = points
         self._cmd_pub.publish(msg)
 
     def log_notes(self) -> None:

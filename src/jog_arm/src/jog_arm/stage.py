@@ -16,11 +16,12 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Sequence
+from typing import NamedTuple
 
 from compliant_common.typedefs import FloatArray
 
 from jog_arm.contact_guard import ContactGuard
-from jog_arm.jog_calcs import JogCalcs, JogOutput
+from jog_arm.jog_calcs import JogCalcs, Point
 from jog_arm.model_frames import ModelFrames
 from jog_arm.settings import JogSettings
 from jog_arm.status import StatusCode
@@ -30,7 +31,6 @@ __all__ = ["ContactSource", "JogCycle", "JogStage", "log_level"]
 
 #: The latest contact force on the tool: ((fx, fy, fz) [N], its frame, the time it was measured [s]), or None.
 ContactSource = Callable[[], "tuple[Sequence[float], str, float] | None"]
-Point = tuple[tuple[float, ...], tuple[float, ...], float]  # positions, velocities, time_from_start [s]
 
 NOTE_SHOWN_FOR = 1.0  # [s] a clock jump stays in the status at least this long
 MISSED_WARNING_EVERY = 10.0  # [s] between warnings about missed cycles
@@ -38,31 +38,37 @@ MISSED_WARNING_EVERY = 10.0  # [s] between warnings about missed cycles
 _GUARD_OUTRANKS = (StatusCode.NO_WARNING, StatusCode.JOINT_VELOCITY_SCALED, StatusCode.STALE_COMMAND)
 
 
-class JogCycle:
-    """What one cycle produced, for the node to publish. One instance per stage, refilled every cycle.
+class JogCycle(NamedTuple):
+    """What one cycle produced, for the node to publish: a new one per cycle (immutable).
 
     Attributes:
-        publish: Whether a joint command is due (`points` is valid).
-        points: The command's trajectory points (one, or `simu_points` extrapolated ones).
-        velocities: The command's joint velocities (for a velocity interface).
+        t: The cycle's time [s].
+        publish: Whether a joint command is due (`positions`, `velocities` and `ahead` are its).
+        positions: The command's joint positions [rad] (a trajectory's first point, `pub_period` ahead).
+        velocities: The command's joint velocities [rad/s] (also all of a velocity interface's command).
+        ahead: A trajectory's further points (simu mode: `simu_points` - 1 extrapolated ones), else ().
         status, message, condition, scale: For the status message.
         status_changed: The status code differs from the previous cycle's (worth a log line).
-        t: The cycle's time [s].
     """
 
-    __slots__ = ("condition", "message", "points", "publish", "scale", "status", "status_changed", "t",
-                 "velocities")
+    t: float
+    publish: bool
+    positions: tuple[float, ...]
+    velocities: tuple[float, ...]
+    ahead: tuple[Point, ...]
+    status: StatusCode
+    message: str
+    condition: float
+    scale: float
+    status_changed: bool
 
-    def __init__(self) -> None:
-        self.publish = False
-        self.points: list[Point] = []
-        self.velocities: tuple[float, ...] = ()
-        self.status = StatusCode.NO_JOINT_STATE
-        self.message = ""
-        self.condition = math.nan
-        self.scale = 0.0
-        self.status_changed = False
-        self.t = 0.0
+
+def _jog_cycle(t: float, publish: bool, positions: tuple[float, ...], velocities: tuple[float, ...],
+               ahead: tuple[Point, ...], status: StatusCode, message: str, condition: float, scale: float,
+               status_changed: bool) -> JogCycle:
+    """`JogCycle(...)` in one allocation instead of two (see `jog_calcs._jog_output`)."""
+    return tuple.__new__(JogCycle, (t, publish, positions, velocities, ahead, status, message, condition,
+                                    scale, status_changed))
 
 
 class JogStage:
@@ -93,8 +99,7 @@ class JogStage:
         self._monotonic = monotonic
         self._period = s.pub_period
         self._points = s.simu_points if s.simu else 1
-        self._cycle = JogCycle()
-        self._cycled = False
+        self._last_cycle: JogCycle | None = None
         self._last_status = StatusCode.NO_JOINT_STATE
         self._cycles = CycleMonitor(s.pub_period)
         self._next_missed_warning = -math.inf
@@ -228,17 +233,10 @@ class JogStage:
             self._next_missed_warning = t + MISSED_WARNING_EVERY
             self.notes.append(("warn", f"{self._cycles.missed} publish cycles missed so far (longest gap "
                                f"{self._cycles.max_gap * 1e3:.1f} ms, period {self._period * 1e3:g} ms)"))
-        out: JogOutput = self.jog.step(t)
-        self._cycled = True
-        c = self._cycle
-        c.t = t
-        c.publish = out.publish
-        if out.publish:
-            c.velocities = out.velocities
-            if self._points > 1:
-                c.points = self.jog.trajectory_points(self._points)
-            else:
-                c.points = [(out.positions, out.velocities, self._period)]
+        out = self.jog.step(t)
+        ahead: tuple[Point, ...] = ()
+        if out.publish and self._points > 1:
+            ahead = self.jog.points_ahead(out, self._points)
         status, message = out.status, out.message
         if self._guard_acted and self._from_topic and status in _GUARD_OUTRANKS:
             status, message = StatusCode.CONTACT_GUARD, self._guard_note
@@ -247,15 +245,16 @@ class JogStage:
                 message = f"{self._fault_note}; {message}"
             else:
                 self._fault_note = ""
-        c.status, c.message, c.condition, c.scale = status, message, out.condition_number, out.speed_scale
-        c.status_changed = status != self._last_status
+        changed = status != self._last_status
         self._last_status = status
-        return c
+        cycle = self._last_cycle = _jog_cycle(t, out.publish, out.positions, out.velocities, ahead, status,
+                                              message, out.condition_number, out.speed_scale, changed)
+        return cycle
 
     @property
     def last_cycle(self) -> JogCycle | None:
         """The last cycle's output (None before the first)."""
-        return self._cycle if self._cycled else None
+        return self._last_cycle
 
     def prepare(self) -> None:
         """The next cycle's twist-independent work (Jacobian, factorisation) now: call it after publishing,
