@@ -8,6 +8,8 @@ HARDWARE_ARGS ?=
 BAG ?=
 ENV := scripts/with_env
 PYTEST_ARGS ?=
+# Test files run on this many workers (pytest-xdist, whole files per worker); 0: one process, in order.
+PYTEST_WORKERS ?= 2
 
 .PHONY: setup build test lint demo bench robot check-robot param-tables clean
 
@@ -18,7 +20,7 @@ build:
 	@scripts/bootstrap
 
 test: build
-	@$(ENV) python -m pytest $(PYTEST_ARGS)
+	@$(ENV) python -m pytest $(if $(filter 0,$(PYTEST_WORKERS)),,-n $(PYTEST_WORKERS) --dist loadfile) $(PYTEST_ARGS)
 
 lint: build
 	@$(ENV) ruff check src tests scripts
