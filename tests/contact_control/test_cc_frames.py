@@ -48,3 +48,16 @@ def test_compose_inverse_and_rotations(a, b):
     assert np.array(transpose_times(rotation(A), rotation(B))) == pytest.approx(Ra.T @ Rb)
     v = [0.1, -0.2, 0.3, 0.4, 0.5, -0.6]
     assert rotate_twist(rotation(A), v) == pytest.approx(np.concatenate([Ra @ v[:3], Ra @ v[3:]]))
+
+
+def test_matrix_quaternion_inverts_quaternion_matrix_on_every_branch():
+    """Shepperd's four branches (trace > 0, then the largest diagonal x, y, z) each round-trip."""
+    import numpy as np
+    from contact_control.frames import matrix_quaternion, quaternion_matrix
+
+    rng = np.random.default_rng(3)
+    cases = [rng.normal(size=4) for _ in range(200)]
+    cases += [np.array(q, float) for q in ([1, 0, 0, 0.01], [0, 1, 0, 0.01], [0, 0, 1, 0.01], [0, 0, 0, 1])]
+    for q in cases:
+        q = q / np.linalg.norm(q) * (1 if q[3] >= 0 else -1)
+        assert np.allclose(matrix_quaternion(quaternion_matrix(*q)), q, atol=1e-9), q

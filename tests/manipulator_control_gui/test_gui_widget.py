@@ -13,7 +13,7 @@ import pytest
 from cartesian_impedance_msgs.msg import CartesianForceCtrlErrorCodes
 from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlResponse
 from compliant_control_msgs.msg import AxisState, ContactControlStatus
-from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsResponse
+from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsResponse, Guide, GuideResponse
 from manipulator_control_gui.form_config import AXES, load_config
 from manipulator_control_gui.ros_client import RosNames
 from std_srvs.srv import Trigger, TriggerResponse
@@ -46,6 +46,8 @@ class FakeContactControl:
             self.services.append(
                 rospy.Service(f"{node}/{name}", Trigger, lambda _req, n=name: self._trigger(n))
             )
+        self.guides: list[bool] = []
+        self.services.append(rospy.Service(f"{node}/guide", Guide, self._guide))
         self.status = rospy.Publisher(f"{node}/status", ContactControlStatus, queue_size=10)
 
     def _configure(self, req):
@@ -65,6 +67,14 @@ class FakeContactControl:
     def _trigger(self, name: str) -> TriggerResponse:
         self.triggers.append(name)
         return TriggerResponse(success=True, message=f"{name} done by the test service")
+
+    def _guide(self, req) -> GuideResponse:
+        self.guides.append(req.enable)
+        if req.enable and not self.success:
+            return GuideResponse(success=False, code=99999, message="hand-guiding refused: a contact move is "
+                                 "running (move 3): z=force_tracking; stop it first (~stop)")
+        return GuideResponse(success=True, code=1, message="hand-guiding on (move 4)" if req.enable
+                             else "hand-guiding off: the arm comes to rest")
 
     def close(self) -> None:
         self.gate.set()
@@ -446,3 +456,32 @@ def test_rqt_plugin_builds_the_panel_and_keeps_the_form(qapp, ros_node):
     finally:
         plugin.shutdown_plugin()
         plugin.widget.deleteLater()
+
+
+def test_guide_toggle_calls_the_service_shows_the_answer_and_follows_the_status(fake, ns, make_widget, pump):
+    widget = make_widget(ns)
+    click(widget.guide_button)
+    pump(lambda: fake.guides == [True], message="the guide call")
+    pump(lambda: widget.answer_label.text() == "Guide done: hand-guiding on (move 4)", message="the answer")
+    status = ContactControlStatus(move_active=True, guiding=True, safety=ContactControlStatus.SAFETY_OK)
+    status.axes = [AxisState(axis=axis, law=1) for axis in AXES]
+    fake.status.publish(status)
+    pump(lambda: widget.guide_button.isChecked(), message="the toggle to show guiding")
+    click(widget.guide_button)
+    pump(lambda: fake.guides == [True, False], message="the off call")
+    status.guiding = status.move_active = False
+    for _ in range(3):  # the readout follows the status, whatever the click showed
+        fake.status.publish(status)
+    pump(lambda: not widget.guide_button.isChecked() and "off" in widget.answer_label.text(),
+         message="the toggle to show not guiding")
+
+
+def test_guide_refused_shows_the_reason(ns, make_widget, pump, ros_node):
+    refusing = FakeContactControl(ros_node, ns, success=False)
+    try:
+        widget = make_widget(ns)
+        click(widget.guide_button)
+        pump(lambda: "contact move is running" in widget.answer_label.text(), message="the reason")
+        assert widget.answer_label.text().startswith("Guide refused: hand-guiding refused")
+    finally:
+        refusing.close()

@@ -883,6 +883,8 @@ class ContactControl:
         force = (w[0] ** 2 + w[1] ** 2 + w[2] ** 2) ** 0.5 if w else float("nan")
         torque = (w[3] ** 2 + w[4] ** 2 + w[5] ** 2) ** 0.5 if w else float("nan")
         p = self.preprocessor
+        if w:
+            self._wrench = w  # ~status and the events show the wrench that tripped
         self._latched = True
         self._reaction.clear()  # nothing moves after a safety trip, whatever the exceeded action said
         self._v = [0.0] * 6

@@ -11,6 +11,7 @@ __all__ = [
     "IDENTITY",
     "compose",
     "inverse",
+    "matrix_quaternion",
     "quaternion_matrix",
     "rotate_twist",
     "rotation",
@@ -32,6 +33,26 @@ def quaternion_matrix(x: float, y: float, z: float, w: float) -> Rows:
         [2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)],
         [2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)],
     ]
+
+
+def matrix_quaternion(r: Sequence[Sequence[float]]) -> tuple[float, float, float, float]:
+    """The unit quaternion (x, y, z, w) of a rotation (3x3 or 4x4 rows), w >= 0 (Shepperd's method: the
+    largest of the four diagonal sums is the divisor)."""
+    trace = r[0][0] + r[1][1] + r[2][2]
+    if trace > 0.0:
+        s = 2.0 * (trace + 1.0) ** 0.5
+        q = ((r[2][1] - r[1][2]) / s, (r[0][2] - r[2][0]) / s, (r[1][0] - r[0][1]) / s, 0.25 * s)
+    elif r[0][0] > r[1][1] and r[0][0] > r[2][2]:
+        s = 2.0 * (1.0 + r[0][0] - r[1][1] - r[2][2]) ** 0.5
+        q = (0.25 * s, (r[0][1] + r[1][0]) / s, (r[0][2] + r[2][0]) / s, (r[2][1] - r[1][2]) / s)
+    elif r[1][1] > r[2][2]:
+        s = 2.0 * (1.0 + r[1][1] - r[0][0] - r[2][2]) ** 0.5
+        q = ((r[0][1] + r[1][0]) / s, 0.25 * s, (r[1][2] + r[2][1]) / s, (r[0][2] - r[2][0]) / s)
+    else:
+        s = 2.0 * (1.0 + r[2][2] - r[0][0] - r[1][1]) ** 0.5
+        q = ((r[0][2] + r[2][0]) / s, (r[1][2] + r[2][1]) / s, 0.25 * s, (r[1][0] - r[0][1]) / s)
+    n = (q[0] ** 2 + q[1] ** 2 + q[2] ** 2 + q[3] ** 2) ** 0.5 * (1.0 if q[3] >= 0.0 else -1.0)
+    return (q[0] / n, q[1] / n, q[2] / n, q[3] / n)
 
 
 def transform(translation: Sequence[float], quaternion: Sequence[float]) -> Rows:

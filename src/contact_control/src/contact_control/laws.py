@@ -3,7 +3,8 @@
 F is the force [N] (torque [Nm] on rotational axes) along the axis in the control frame, d the travel since
 the law was set [m] ([rad]), V the commanded velocity [m/s] ([rad/s]):
 
-- follower: V = F / b when |F| > deadband, else 0 (the rate limit then decelerates smoothly).
+- follower: V = F / b when |F| > deadband, else 0 (the rate limit then decelerates smoothly); |V| at most
+  `velocity` when that is > 0 (hand-guiding's speed cap).
 - spring: V = scale * round(round(F) / b - k (d + d_offset)), rounding to `spring_rounding`.
   k is in 1/s here (GCCF's form), the equivalent impedance stiffness is b * k [N/m].
 - compliant move: V = V_desired + F / b (no force term when b = 0); within `slowdown` of the max travel the
@@ -54,7 +55,7 @@ class AxisLaw:
             move.
         stiffness: k [1/s] of the spring law.
         velocity: V_desired of the compliant move [m/s] or [rad/s]; its sign is the direction. Force tracking:
-            the approach speed (> 0) while out of contact.
+            the approach speed (> 0) while out of contact. Follower: a speed cap (> 0; 0: none).
         force_limit: |F| at or above this ends the move (FT_VIOLATION); 0: no limit.
         max_travel: |d| at or above this ends the move (MAX_TRAVEL); 0: no limit.
         offset: d_offset of the spring law [m] or [rad].
@@ -85,7 +86,11 @@ def law_velocity(law: AxisLaw, tuning: AxisTuning, force: float, travel: float) 
     if kind == LAW_FOLLOWER:
         if -tuning.deadband <= force <= tuning.deadband:
             return 0.0
-        return force / law.damping
+        v = force / law.damping
+        cap = law.velocity  # hand-guiding's speed cap (0: none but the clamp)
+        if cap > 0.0 and not -cap <= v <= cap:
+            return cap if v > 0.0 else -cap
+        return v
     if kind == LAW_SPRING:
         step = tuning.spring_rounding
         v = round_to(force, step) / law.damping - law.stiffness * (travel + law.offset)

@@ -15,6 +15,8 @@ from compliant_common.errors import StackError
 from compliant_common.schema import SchemaError, param, schema_of
 from compliant_common.typedefs import ParamMap
 
+from contact_control.axes import AXES
+
 __all__ = ["PARAMETERS", "AxisTuning", "ContactControlSettings", "ParamError", "load_settings"]
 
 
@@ -252,6 +254,40 @@ class ContactControlSettings:
         doc="force tracking is out of contact, and approaches at least at its approach speed, while F is "
         "short of this fraction of the target",
     )
+    # contact events (~events) and hand-guiding (~guide)
+    event_touch_force: float = _pos(
+        3.0, "N", "|F| (preprocessed contact force, control frame) at which ~events reports a touch (above a "
+        "UR e-series sensor's 0.2-0.6 N noise with margin; a guess for others)"
+    )
+    event_release_force: float = param(
+        1.5, unit="N", ge=0.0, shown_range=">= 0, < `event_touch_force`",
+        doc="|F| below which ~events reports the release (hysteresis)",
+    )
+    guide_axes: tuple[str, ...] = param(
+        AXES, type="strings", shown_range="names of x, y, z, rx, ry, rz",
+        doc="axes `~guide` makes followers when its request names none",
+    )
+    guide_damping_linear: float = _pos(
+        50.0, "N/(m/s)", "hand-guiding follower damping b on X, Y, Z (a 10 N push: 0.2 m/s; a guess, tune "
+        "per robot)"
+    )
+    guide_damping_angular: float = _pos(
+        4.0, "Nm/(rad/s)", "same on RX, RY, RZ (a 2 Nm twist: 0.5 rad/s; a guess)"
+    )
+    guide_max_velocity_linear: float = _pos(
+        0.25, "m/s", "hand-guiding speed cap on X, Y, Z (`max_velocity` still clamps)"
+    )
+    guide_max_velocity_angular: float = _pos(
+        0.5, "rad/s", "same on RX, RY, RZ (the angular clamp still applies)"
+    )
+    guide_force_limit: float = _nonneg(
+        0.0, "N", "hand-guiding ends on a force over this on a guided linear axis (0: only the global limits)"
+    )
+    guide_torque_limit: float = _nonneg(0.0, "Nm", "same for torques on guided rotational axes")
+    guide_exceeded_action: int = param(
+        0, choices=(0, 1, 2), doc="what a guided axis does after its limit: 0 stop, 1 move_away, 2 "
+        "gravity_compensation (AxisLaw ACTION_*)",
+    )
     diff_max_force: float = _nonneg(
         0.0, "N", "force change within `diff_window` that ends a move (force-jump end condition; 0: off)"
     )
@@ -398,5 +434,9 @@ def _check_cross_constraints(s: ContactControlSettings) -> None:
             # Not above the clamp (it would be cut anyway), above min velocity (it would never move).
             if not t.min_velocity < value <= t.max_velocity:
                 raise ParamError(key, f"must exceed min_velocity_{suffix} and not exceed {t.max_velocity}")
+    if s.event_release_force >= s.event_touch_force:
+        raise ParamError("event_release_force", f"must be below event_touch_force {s.event_touch_force}")
+    if not s.guide_axes or any(n not in AXES for n in s.guide_axes):
+        raise ParamError("guide_axes", f"must name axes of {', '.join(AXES)}; got {list(s.guide_axes)}")
     if s.no_data_end_timeout and s.no_data_end_timeout < s.wrench_timeout:
         raise ParamError("no_data_end_timeout", "must be 0 or at least wrench_timeout")

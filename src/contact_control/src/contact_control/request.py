@@ -267,7 +267,15 @@ def _axis_law(
             LAW_SPRING, damping=b, stiffness=k, force_limit=limit, max_travel=travel, exceeded_action=action
         )
     if law == LAW_FOLLOWER:
-        return AxisLaw(LAW_FOLLOWER, damping=b, force_limit=limit, max_travel=travel, exceeded_action=action)
+        cap = 0.0
+        if target is not None:  # ConfigureLaws: velocity caps the follower's speed (ConfigureForceControl's
+            # max_cart_vel was never read for a follower and still is not)
+            if not (v >= 0.0 and math.isfinite(v)):
+                raise fail(SET_CARTESIAN_CONTROL_FAILED, f"speed cap must be finite, >= 0 {unit_v} (0: none)",
+                           "v")
+            cap = v
+        return AxisLaw(LAW_FOLLOWER, damping=b, velocity=cap, force_limit=limit, max_travel=travel,
+                       exceeded_action=action)
     if law == LAW_FORCE_TRACKING:
         assert target is not None  # refused above
         return _tracking_law(axis, b, v, limit, travel, action, float(target), limits, fail)

@@ -2,7 +2,8 @@
 
 Used by contact_control_node and by control_stack_node (which shares a process with jog_arm); both keep the
 same names: services `configure_cartesian_impedance[_blocking]` and `configure_laws` in the node's
-namespace, `tare`, `stop`, `reset`, `payload/*`, `status` and `contact_wrench` under the node's name.
+namespace, `tare`, `stop`, `reset`, `guide`, `payload/*`, `status`, `events` and `contact_wrench` under the
+node's name.
 """
 
 from __future__ import annotations
@@ -20,14 +21,23 @@ from cartesian_impedance_msgs.srv import (
     ConfigureForceControlResponse,
 )
 from compliant_common.ros_time import TimerEvent, timer
-from compliant_control_msgs.msg import AxisState, ContactControlStatus
-from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsRequest, ConfigureLawsResponse
+from compliant_control_msgs.msg import AxisState, ContactControlStatus, ContactEvent
+from compliant_control_msgs.srv import (
+    ConfigureLaws,
+    ConfigureLawsRequest,
+    ConfigureLawsResponse,
+    Guide,
+    GuideRequest,
+    GuideResponse,
+)
 from geometry_msgs.msg import TwistStamped, WrenchStamped
 from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 
 from contact_control.axes import AXES, END_NAMES, EXCEEDED_ACTION_NAMES, LAW_NAMES, SAFETY_NAMES
 from contact_control.controller import CycleResult
-from contact_control.frames import transform
+from contact_control.events import EVENT_NAMES
+from contact_control.events import ContactEvent as Event
+from contact_control.frames import matrix_quaternion, transform
 from contact_control.params import ContactControlSettings, ParamError, load_settings
 from contact_control.payload_service import PayloadServices
 from contact_control.request import CODE_NAMES
@@ -81,7 +91,7 @@ class TfPoses:
 
 
 class ContactControlRos:
-    """Services, status and publishers of contact_control; every stage call holds `lock`.
+    """Services, status, events and publishers of contact_control; every stage call holds `lock`.
 
     Args:
         stage: The contact stage.
@@ -119,6 +129,8 @@ class ContactControlRos:
         self._contact_msg.header.frame_id = s.control_frame
         self._contact_pub = rospy.Publisher(private_ns + "contact_wrench", WrenchStamped, queue_size=1,
                                             tcp_nodelay=True)
+        # Rare (a touch, a move's end): published from the cycle that found them, latched for late joiners.
+        self._events_pub = rospy.Publisher(private_ns + "events", ContactEvent, queue_size=20, latch=True)
         self._status_msg = ContactControlStatus(axes=[AxisState(axis=name) for name in AXES])
         self._status_msg.header.frame_id = s.control_frame
         # Service names in the node's namespace (not private), as the original served them.
@@ -131,6 +143,7 @@ class ContactControlRos:
             rospy.Service(private_ns + "tare", Trigger, self._on_tare),
             rospy.Service(private_ns + "stop", Trigger, self._on_stop),
             rospy.Service(private_ns + "reset", Trigger, self._on_reset),
+            rospy.Service(private_ns + "guide", Guide, self._on_guide),
         ]
         self.payload = PayloadServices(
             private_ns,
@@ -170,9 +183,28 @@ class ContactControlRos:
             for level, text in stage.notes:
                 (rospy.logwarn if level.startswith("warn") else rospy.loginfo)("contact_control: %s", text)
             stage.notes.clear()
+        if stage.events:
+            for event in stage.events:
+                self._events_pub.publish(self._event_msg(event))
+            stage.events.clear()
         if stage.ended:
             stage.ended = False
             self._ended.notify_all()
+
+    def _event_msg(self, event: Event) -> ContactEvent:
+        msg = ContactEvent(type=event.kind, type_name=EVENT_NAMES[event.kind], move_id=event.move_id,
+                           message=event.message)
+        msg.header.stamp = rospy.Time.from_sec(event.t)
+        msg.header.frame_id = self._s.control_frame
+        f, q = msg.wrench.force, msg.wrench.torque
+        f.x, f.y, f.z, q.x, q.y, q.z = event.wrench
+        if event.pose is not None:
+            msg.pose.header.stamp = msg.header.stamp
+            msg.pose.header.frame_id = self._s.fixed_frame
+            p, o = msg.pose.pose.position, msg.pose.pose.orientation
+            p.x, p.y, p.z = (row[3] for row in event.pose[:3])
+            o.x, o.y, o.z, o.w = matrix_quaternion(event.pose)
+        return msg
 
     def emit_locked(self, velocity: Velocity | None, t: float) -> None:
         """Hands a twist a request or a fault produced to `emit` (lock held)."""
@@ -198,6 +230,15 @@ class ContactControlRos:
         with self._lock:
             answer = self._configure(req, True, "configure_laws")
         return ConfigureLawsResponse(success=answer.ok, code=answer.code, message=answer.message)
+
+    def _on_guide(self, req: GuideRequest) -> GuideResponse:
+        """compliant_control_msgs/Guide: hand-guiding on the chosen axes, or off; the answer says why not."""
+        with self._lock:
+            t = rospy.get_time()
+            answer, zero = self._stage.guide(req.enable, list(req.axes), t)
+            (rospy.loginfo if answer.ok else rospy.logwarn)("contact_control: %s", answer.message)
+            self.emit_locked(zero, t)
+        return GuideResponse(success=answer.ok, code=answer.code, message=answer.message)
 
     @staticmethod
     def _response(success: bool) -> ConfigureForceControlResponse:
@@ -278,9 +319,11 @@ class ContactControlRos:
             return
         with self._lock:
             r, message = self._stage.status()
+            guiding = self._stage.guiding
         msg = self._status_msg  # reused: the status timer allocates nothing per cycle
         msg.header.stamp = rospy.Time.now()
         msg.move_active = r.move_active
+        msg.guiding = guiding
         msg.safety = r.safety
         msg.message = message
         w, v = r.wrench, r.velocity

@@ -18,15 +18,18 @@ from contact_control.axes import (
     AXES,
     EXCEEDED_ACTION_NAMES,
     LAW_COMPLIANT_MOVE,
+    LAW_FOLLOWER,
     LAW_FORCE_TRACKING,
     LAW_NAMES,
     SAFETY_NO_TF,
 )
 from contact_control.controller import ContactControl, CycleResult
+from contact_control.events import ContactEvent, EventWatch
 from contact_control.frames import IDENTITY, Rows, compose, inverse, rotate_twist, rotation, transpose_times
 from contact_control.laws import AxisLaw
 from contact_control.params import ContactControlSettings
 from contact_control.request import (
+    FAILURE,
     SUCCESS,
     ForceControlRequest,
     LawsRequest,
@@ -103,6 +106,10 @@ class ContactStage:
         self.ended = False
         #: (level, text) for the node's log, drained by it.
         self.notes: list[tuple[str, str]] = []
+        self._events = EventWatch(s.event_touch_force, s.event_release_force)
+        #: Contact events with the EEF pose, drained by the node (~events).
+        self.events: list[ContactEvent] = []
+        self._guide_move = 0  # the move id of hand-guiding (0: never guided)
 
     # --- frames ---
     def _pose(self, frame: str) -> list[list[float]]:
@@ -215,6 +222,10 @@ class ContactStage:
     # --- publish policy ---
     def _emit(self, result: CycleResult, R_command_control: Rows | None = None) -> Velocity | None:
         """The twist to send for a cycle's result, per the publish policy; notes a move's end."""
+        watch = self._events
+        watch.observe(result, self.ctrl.end_message)
+        if watch.pending:
+            self._take_events()
         velocity: Velocity | None = None
         if result.commanding:  # a move, or an exceeded action after it (moving away, hand-guiding)
             self._idle_zeros = int(self.settings.idle_zero_count)
@@ -233,7 +244,72 @@ class ContactStage:
         self._was_active = result.commanding
         return velocity
 
+    def _take_events(self) -> None:
+        """Moves the watch's events to `events`, each with the EEF pose (this cycle's lookup if made)."""
+        try:
+            pose: Rows | None = self._pose(self.settings.eef_frame)
+        except LookupError:
+            pose = None
+        self.events.extend(e._replace(pose=pose) for e in self._events.pending)
+        self._events.pending.clear()
+
     # --- requests ---
+    @property
+    def guiding(self) -> bool:
+        """Hand-guiding (`guide`) is the running move."""
+        ctrl = self.ctrl
+        return ctrl.move_active and ctrl.move_id == self._guide_move
+
+    def guide(self, enable: bool, axes: Sequence[str], t: float) -> tuple[Answer, Velocity | None]:
+        """Switches hand-guiding on (followers on `axes`, empty: `guide_axes`) or off; the answer and a zero
+        twist to send when it stops. Refused, changing nothing, while another move runs."""
+        s = self.settings
+        if not enable:
+            if not self.guiding:
+                return Answer(True, SUCCESS, "hand-guiding was not on: nothing changed", 0), None
+            return Answer(True, SUCCESS, "hand-guiding off: the arm comes to rest", 0), self.stop(
+                "hand-guiding switched off")
+        names = tuple(a.strip().lower() for a in axes) or s.guide_axes
+        unknown = [a for a in names if a not in AXES]
+        if unknown:
+            return self._refuse(FAILURE, f"hand-guiding: unknown axis {', '.join(unknown)} (axes are "
+                                         f"{', '.join(AXES)})"), None
+        ctrl = self.ctrl
+        if ctrl.move_active and not self.guiding:
+            running = describe_laws(ctrl.move_id, ctrl.laws).replace("contact laws set ", "")
+            return self._refuse(FAILURE, f"hand-guiding refused: a contact move is running {running}; stop "
+                                         "it first (~stop)"), None
+        laws = [AxisLaw()] * 6
+        for i, name in enumerate(AXES):
+            if name in names:
+                angular = i >= 3
+                laws[i] = AxisLaw(
+                    LAW_FOLLOWER,
+                    damping=s.guide_damping_angular if angular else s.guide_damping_linear,
+                    velocity=s.guide_max_velocity_angular if angular else s.guide_max_velocity_linear,
+                    force_limit=s.guide_torque_limit if angular else s.guide_force_limit,
+                    exceeded_action=s.guide_exceeded_action,
+                )
+        try:
+            move_id = ctrl.set_laws(laws, None, t)
+        except RequestError as err:
+            return self._refuse(err.code, f"hand-guiding refused: {err.message}"), None
+        self._guide_move = move_id
+        self._request_note = ""
+        self._idle_zeros = int(s.idle_zero_count)
+        self.ended = True
+        guided = " ".join(a for a in AXES if a in names)
+        message = (f"hand-guiding on (move {move_id}): {guided} follow the "
+                   f"push (b {s.guide_damping_linear:g} N/(m/s), {s.guide_damping_angular:g} Nm/(rad/s); at "
+                   f"most {s.guide_max_velocity_linear:g} m/s, {s.guide_max_velocity_angular:g} rad/s)")
+        if ctrl.zeroing:
+            message += "; the sensor is still being zeroed: keep the tool free until ~status shows safety ok"
+        return Answer(True, SUCCESS, message, move_id), None
+
+    def _refuse(self, code: int, message: str) -> Answer:
+        self._request_note = f"last request refused (code {code}): {message}"
+        return Answer(False, code, message, 0)
+
     def configure(
         self, req: ForceControlRequest | LawsRequest, t: float, per_axis: bool = False
     ) -> Answer:
@@ -292,5 +368,7 @@ def describe_laws(move_id: int, laws: Sequence[AxisLaw]) -> str:
                 notes = [f"target {law.target:g}", f"b {law.damping:g}", f"approach {law.velocity:g}"]
             if law.exceeded_action:
                 notes.append(EXCEEDED_ACTION_NAMES[law.exceeded_action])
+            if law.law == LAW_FOLLOWER and law.velocity > 0.0:
+                notes.insert(0, f"at most {law.velocity:g}")
             parts.append(f"{AXES[i]}={LAW_NAMES[law.law]}" + (f" ({', '.join(notes)})" if notes else ""))
     return f"contact laws set (move {move_id}): {', '.join(parts) or 'none (all axes still)'}"

@@ -39,6 +39,7 @@ class GuiSettings:
     stop_service: str = _derived("`<contact_control_node>/stop`", "Trigger service of Stop")
     tare_service: str = _derived("`<contact_control_node>/tare`", "Trigger service of Tare")
     reset_service: str = _derived("`<contact_control_node>/reset`", "Trigger service of Reset")
+    guide_service: str = _derived("`<contact_control_node>/guide`", "Guide service of the Guide toggle")
     status_topic: str = _derived("`<contact_control_node>/status`", "status topic of the readout")
     retry_period: float = param(1.0, unit="s", gt=0.0, doc="how often the panel looks for the services")
 

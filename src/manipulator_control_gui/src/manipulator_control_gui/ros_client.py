@@ -6,6 +6,7 @@ callbacks into Qt signals. rospy must be initialised (rospy.init_node, or rqt) b
 
 from __future__ import annotations
 
+import dataclasses
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -30,6 +31,7 @@ class RosNames:
     tare_service: str = f"{_NODE}/tare"
     stop_service: str = f"{_NODE}/stop"
     reset_service: str = f"{_NODE}/reset"
+    guide_service: str = f"{_NODE}/guide"
     status_topic: str = f"{_NODE}/status"
     #: compliant_control_msgs/ConfigureLaws, used instead of configure_service when registered (it answers
     #: with the reason of a refusal).
@@ -47,6 +49,7 @@ class RosNames:
             tare_service=settings.tare_service or f"{node}/tare",
             stop_service=settings.stop_service or f"{node}/stop",
             reset_service=settings.reset_service or f"{node}/reset",
+            guide_service=settings.guide_service or f"{node}/guide",
             status_topic=settings.status_topic or f"{node}/status",
             laws_service=settings.configure_laws_service or f"{namespace}{slash}{cls.laws_service}",
         )
@@ -116,19 +119,8 @@ class ContactControlClient:
 
         self._rospy = rospy
         self.names = names
-        self.resolved = RosNames(
-            *(
-                rospy.resolve_name(n)
-                for n in (
-                    names.configure_service,
-                    names.tare_service,
-                    names.stop_service,
-                    names.reset_service,
-                    names.status_topic,
-                    names.laws_service,
-                )
-            )
-        )
+        fields = dataclasses.fields(names)
+        self.resolved = RosNames(**{f.name: rospy.resolve_name(getattr(names, f.name)) for f in fields})
         self._on_status = on_status
         self._on_availability = on_availability
         self._retry_period = retry_period
@@ -227,6 +219,16 @@ class ContactControlClient:
             return CallResult(True, bool(response.success), None, str(response.message))
 
         self._call(name, Trigger, TriggerRequest(), answer, on_done)
+
+    def guide(self, enable: bool, on_done: Callable[[CallResult], None]) -> None:
+        """Switches hand-guiding on (the node's guide_axes) or off in a worker thread; the result carries the
+        node's answer (what runs now, or why not)."""
+        from compliant_control_msgs.srv import Guide, GuideRequest
+
+        def answer(response: Any) -> CallResult:
+            return CallResult(True, bool(response.success), int(response.code), str(response.message))
+
+        self._call(self.resolved.guide_service, Guide, GuideRequest(enable=enable), answer, on_done)
 
     def _call(
         self,

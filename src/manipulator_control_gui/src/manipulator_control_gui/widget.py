@@ -227,11 +227,16 @@ class ControlWidget(QWidget):
         self.tare_button.setToolTip("Zero the force/torque sensor (nothing should touch the tool)")
         self.reset_button = QPushButton("Reset", self)
         self.reset_button.setToolTip("Clear a latched safety stop")
+        self.guide_button = QPushButton("Guide", self)
+        self.guide_button.setCheckable(True)
+        self.guide_button.setToolTip("Hand-guiding: the arm follows a push on every axis (the tool's weight "
+                                     "compensated); press again to stop, the arm comes to rest")
         for button, name in (
             (self.apply_button, "apply"),
             (self.stop_button, "stop"),
             (self.tare_button, "tare"),
             (self.reset_button, "reset"),
+            (self.guide_button, "guide"),
         ):
             button.setObjectName(f"{name}_button")
             buttons.addWidget(button)
@@ -240,6 +245,7 @@ class ControlWidget(QWidget):
         self.stop_button.clicked.connect(lambda: self._trigger("stop"))
         self.tare_button.clicked.connect(lambda: self._trigger("tare"))
         self.reset_button.clicked.connect(lambda: self._trigger("reset"))
+        self.guide_button.clicked.connect(self._guide)
         layout.addLayout(buttons)
 
         self.answer_label = QLabel("", self)
@@ -340,6 +346,12 @@ class ControlWidget(QWidget):
         self._answer(f"{which.capitalize()}: waiting for the answer…", _BUSY_STYLE)
         self.client.trigger(which, lambda result: self._bridge.send("answer", which, result))
 
+    def _guide(self, checked: bool) -> None:
+        """The Guide toggle: the button shows what ~status says once it arrives, not the click."""
+        self._awaiting_reason = False
+        self._answer(f"Guide {'on' if checked else 'off'}: waiting for the answer…", _BUSY_STYLE)
+        self.client.guide(checked, lambda result: self._bridge.send("answer", "guide", result))
+
     # ---- results (UI thread) -------------------------------------------------------------------------------
     def _answer(self, text: str, style: str) -> None:
         self.answer_label.setText(text)
@@ -393,6 +405,9 @@ class ControlWidget(QWidget):
         self.velocity_label.setText(readout.velocity)
         self.state_label.setText(readout.state)
         self.state_label.setStyleSheet("" if readout.ok else _ERROR_STYLE)
+        guiding = bool(getattr(status, "guiding", False))
+        if self.guide_button.isChecked() != guiding:
+            self.guide_button.setChecked(guiding)
         for axis, row in self.rows.items():
             cells = readout.axes.get(axis)
             for name, label in row.readout.items():

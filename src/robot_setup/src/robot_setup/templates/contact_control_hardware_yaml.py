@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from robot_setup.plan import Plan, command_line
-from robot_setup.templates.contact_control_yaml import tool_block
+from robot_setup.templates.contact_control_yaml import guide_block, tool_block
 from robot_setup.templates.driver_text import frame_origin, model_words, written
 from robot_setup.templates.text import comment, num
 
@@ -25,7 +25,7 @@ velocity_command_frame: {plan.base}
 ft_sensor_frame: ft_sensor
 control_frame: {plan.base}
 eef_frame: tool_tip
-{tool_block(plan)}"""
+{tool_block(plan)}{guide_block()}"""
 
 
 def _for_profile(plan: Plan) -> str:
@@ -70,4 +70,4 @@ eef_frame: tool_tip
 {sign}# The filter is rate-true (it measures the rate): designed for the driver's {d.rate:g} Hz until measured.
 lp_filter_delta_t: {num(round(1.0 / d.rate, 4))}            # [s]
 lp_filter_cutoff_freq: 5.0          # [Hz]
-"""
+{guide_block()}"""

@@ -6,7 +6,7 @@ from __future__ import annotations
 from robot_setup.plan import Plan
 from robot_setup.templates.text import generated_by, num
 
-__all__ = ["contact_control_yaml", "tool_block"]
+__all__ = ["contact_control_yaml", "guide_block", "tool_block"]
 
 
 def tool_block(plan: Plan) -> str:
@@ -15,6 +15,16 @@ def tool_block(plan: Plan) -> str:
 tool_mass: {num(plan.spec.tool_mass)}                      # [kg]
 tool_com: [0.0, 0.0, 0.05]          # [m] in the sensor frame
 tare_on_startup: true
+"""
+
+
+def guide_block() -> str:
+    """Hand-guiding (~guide) on this arm: also in every contact_control_hardware.yaml."""
+    return """# Hand-guiding (~guide, the GUI's Guide button): followers with these, the tool's weight compensated.
+guide_damping_linear: 50.0          # [N/(m/s)] a 10 N push: 0.2 m/s
+guide_damping_angular: 4.0          # [Nm/(rad/s)] a 2 Nm twist: 0.5 rad/s
+guide_max_velocity_linear: 0.25     # [m/s]
+guide_max_velocity_angular: 0.5     # [rad/s]
 """
 
 
@@ -34,6 +44,7 @@ control_frame: {plan.base}            # laws act along the base axes
 eef_frame: tool_tip
 
 {tool_block(plan)}
+{guide_block()}
 # Closed-loop tuning of the simulated stack (the hand-written robot packages' values and README).
 acceleration_linear: 0.4            # [m/s^2]
 lp_filter_delta_t: 0.002            # [s] the simulated sensor's sample period
