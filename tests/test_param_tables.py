@@ -20,6 +20,7 @@ EXPECTED = {
     "keyboard_publisher": "keyboard_publisher.teleop:PARAMETERS",
     "named_poses": "named_poses.params:PARAMETERS",
     "manipulator_control_gui": "manipulator_control_gui.params:PARAMETERS",
+    "teach": "teach.params:PARAMETERS",
 }
 
 

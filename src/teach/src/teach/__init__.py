@@ -1,0 +1,1 @@
+"""Teach by hand: programs of hand-guided motions (see the package README)."""

@@ -1,0 +1,143 @@
+"""Programs (teach.program, teach.simplify, teach.recorder): simplification within the tolerance at each
+sample's time, keyframes kept, a YAML round trip, refusals that name what to change."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from teach.program import Program, ProgramError, ProgramStore, check_name
+from teach.recorder import Recorder
+from teach.simplify import interpolate, quaternion_angle, simplify, slerp
+
+JOINTS = ("j1", "j2")
+
+
+def l_path(n_per_leg: int = 250, dt: float = 0.02, noise: float = 0.0002):
+    """A hand-guided L: 10 cm along X then 5 cm along Y, smooth speed profiles, 0.2 mm of tremor."""
+    s = np.linspace(0.0, 1.0, n_per_leg)
+    ease = 3 * s**2 - 2 * s**3
+    x = np.concatenate([0.1 * ease, np.full(n_per_leg, 0.1)])
+    y = np.concatenate([np.zeros(n_per_leg), 0.05 * ease])
+    p = np.stack([x, y, np.full(2 * n_per_leg, 0.3)], axis=1)
+    p += np.random.default_rng(7).normal(0.0, noise, p.shape)
+    angle = np.linspace(0.0, math.radians(20.0), 2 * n_per_leg)  # the tool turns 20 degrees about Z
+    q = np.stack([np.zeros_like(angle), np.zeros_like(angle), np.sin(angle / 2), np.cos(angle / 2)], axis=1)
+    return np.arange(2 * n_per_leg) * dt, p, q
+
+
+def test_simplify_keeps_every_sample_within_the_tolerance_at_its_time_with_few_waypoints():
+    t, p, q = l_path()
+    kept = simplify(t, p, q, position_tolerance=0.001, angle_tolerance=math.radians(1.0))
+    assert kept[0] == 0 and kept[-1] == len(t) - 1
+    assert len(kept) < len(t) / 10, len(kept)
+    worst_p = worst_a = 0.0
+    for ti, pi, qi in zip(t, p, q, strict=True):
+        pos, quat, _ = interpolate(t[kept], p[kept], q[kept], ti)
+        worst_p = max(worst_p, float(np.linalg.norm(pos - pi)))
+        worst_a = max(worst_a, quaternion_angle(quat, qi))
+    assert worst_p <= 0.001 and worst_a <= math.radians(1.0)
+    coarse = simplify(t, p, q, position_tolerance=0.005, angle_tolerance=math.radians(5.0))
+    assert len(coarse) < len(kept)  # a looser tolerance, fewer waypoints
+
+
+def test_simplify_keeps_keyframes_and_a_pause_in_time():
+    t, p, q = l_path(noise=0.0)
+    keep = [False] * len(t)
+    keep[100] = True
+    assert 100 in simplify(t, p, q, keep)
+    # Standing still for 2 s then moving on: the stop is kept (time matters, not only the path).
+    t2 = np.concatenate([t[:250], t[250:] + 2.0])
+    kept = simplify(t2, p, q)
+    pos, _, _ = interpolate(t2[kept], p[kept], q[kept], t2[249] + 1.0)
+    assert np.linalg.norm(pos - p[249]) <= 0.001
+
+
+def test_slerp_takes_the_short_way_and_ends_where_asked():
+    a = (0.0, 0.0, 0.0, 1.0)
+    b = (0.0, 0.0, -math.sin(0.5), -math.cos(0.5))  # the same rotation as +1 rad about Z, other sign
+    mid = slerp(a, b, 0.5)
+    assert quaternion_angle(mid, (0.0, 0.0, math.sin(0.25), math.cos(0.25))) < 1e-9
+    assert quaternion_angle(slerp(a, b, 1.0), b) < 1e-9
+
+
+def recorded(name: str = "l_path", keys: tuple[int, ...] = (120,)) -> Program:
+    rec = Recorder("ur5", "base_link", "tool_tip", 50.0, 0.001, math.radians(1.0))
+    t, p, q = l_path()
+    rec.start(name, 100.0)
+    for i, (ti, pi, qi) in enumerate(zip(t, p, q, strict=True)):
+        if i in keys:
+            rec.keyframe()
+        rec.add(100.0 + ti, JOINTS, (0.1 * i, -0.2), pi, qi, (0.0, 0.0, 1.0 + i * 0.01, 0.0, 0.0, 0.0))
+    return rec.finish()
+
+
+def test_a_recording_becomes_a_program_that_round_trips_through_yaml(tmp_path):
+    program = recorded()
+    assert program.samples == 500 and 2 < len(program.waypoints) < 50
+    assert program.waypoints[0].t == 0.0 and program.duration == pytest.approx(9.98)
+    assert [i for i, w in enumerate(program.waypoints) if w.keyframe] and program.length == pytest.approx(
+        0.15, abs=0.01)
+    store = ProgramStore(str(tmp_path / "programs"))
+    path = store.save(program)
+    text = open(path).read()
+    assert text.startswith("# Program 'l_path' taught by hand on ur5") and "waypoints:" in text
+    again = store.load("l_path")
+    assert again.name == program.name and again.robot == "ur5" and again.joint_names == JOINTS
+    assert len(again.waypoints) == len(program.waypoints)
+    for a, b in zip(again.waypoints, program.waypoints, strict=True):
+        assert a.keyframe == b.keyframe and np.allclose(a.position, b.position, atol=1e-6)
+        assert np.allclose(a.orientation, b.orientation, atol=1e-6) and a.t == pytest.approx(b.t, abs=1e-4)
+    assert store.names() == ["l_path"]
+    with pytest.raises(ProgramError, match="exists"):
+        store.save(program)
+    store.delete("l_path")
+    assert store.names() == []
+    with pytest.raises(ProgramError, match="no program 'l_path'"):
+        store.load("l_path")
+
+
+def test_a_program_of_another_robot_or_joints_is_refused_with_the_reason():
+    program = recorded()
+    program.check_robot("ur5", JOINTS)
+    with pytest.raises(ProgramError, match="recorded on robot 'ur5', this is 'panda'"):
+        program.check_robot("panda", JOINTS)
+    with pytest.raises(ProgramError, match="has joints"):
+        program.check_robot("ur5", ("a", "b"))
+
+
+@pytest.mark.parametrize("bad", ["", "../x", "a b", "x" * 65, ".hidden"])
+def test_bad_names_are_refused(bad):
+    with pytest.raises(ProgramError, match="program name"):
+        check_name(bad)
+
+
+def test_recorder_refusals_change_nothing(tmp_path):
+    rec = Recorder("ur5", "base_link", "tool_tip", 50.0, 0.001, 0.0175)
+    with pytest.raises(ProgramError, match="not recording"):
+        rec.keyframe()
+    with pytest.raises(ProgramError, match="not recording"):
+        rec.finish()
+    rec.start("a", 0.0)
+    with pytest.raises(ProgramError, match="already recording 'a'"):
+        rec.start("b", 1.0)
+    rec.add(0.1, JOINTS, (0, 0), (0, 0, 0), (0, 0, 0, 1), (0,) * 6)
+    with pytest.raises(ProgramError, match="1 sample"):
+        rec.finish()
+    assert not rec.recording
+
+
+def test_malformed_files_are_refused_naming_the_problem(tmp_path):
+    store = ProgramStore(str(tmp_path))
+    (tmp_path / "bad.yaml").write_text("format: 1\nname: bad\n")
+    with pytest.raises(ProgramError, match="missing or malformed field"):
+        store.load("bad")
+    data = recorded().to_dict()
+    data["waypoints"][1]["t"] = -1.0
+    with pytest.raises(ProgramError, match="back in time"):
+        Program.from_dict(data)
+    data = recorded().to_dict()
+    data["format"] = 2
+    with pytest.raises(ProgramError, match="format 2"):
+        Program.from_dict(data)
