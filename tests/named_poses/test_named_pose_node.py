@@ -200,3 +200,28 @@ def test_a_jog_held_during_a_move_is_paused_for_it_and_resumed_after(stack):
     rospy.sleep(0.3)  # jog_arm stale and silent before the trajectory back
     back = _proxy()(name="start", speed_scale=1.0)
     assert back.success, back.message
+
+
+def test_move_to_joints_goes_to_given_positions_and_refuses_missing_or_out_of_limit_ones(stack):
+    import rospy
+    import yaml
+    from compliant_control_msgs.srv import MoveToJoints
+    from rospkg import RosPack
+    from sensor_msgs.msg import JointState
+
+    config = yaml.safe_load(open(RosPack().get_path("ur5_custom") + "/config/named_poses.yaml"))
+    start = config["poses"]["start"]
+    names = list(start)
+    goal = [q + (0.1 if i == 0 else 0.0) for i, q in enumerate(start.values())]  # the base turned 0.1 rad
+    move = rospy.ServiceProxy("/named_poses/move_to_joints", MoveToJoints)
+    answer = move(joint_names=[*names, "a_gripper_joint"], positions=[*goal, 0.02], speed_scale=1.0,
+                  label="the start of program x")
+    assert answer.success and answer.message.startswith("at the start of program x after"), answer.message
+    state = rospy.wait_for_message("/joint_states", JointState, timeout=10)
+    at = dict(zip(state.name, state.position, strict=True))
+    assert max(abs(at[j] - q) for j, q in zip(names, goal, strict=True)) < 0.01
+    missing = move(joint_names=names[1:], positions=goal[1:], speed_scale=1.0, label="")
+    assert not missing.success and f"no position for ['{names[0]}']" in missing.message
+    far = move(joint_names=names, positions=[100.0, *goal[1:]], speed_scale=1.0, label="")
+    assert not far.success and "outside the joint's limits" in far.message
+    assert _proxy()(name="start", speed_scale=1.0).success

@@ -18,6 +18,8 @@ __all__ = [
     "END_NONE",
     "END_NO_FT_DATA",
     "END_OSCILLATION",
+    "END_PATH_ERROR",
+    "END_PATH_LOST",
     "EXCEEDED_ACTION_NAMES",
     "EXCEEDED_GRAVITY_COMPENSATION",
     "EXCEEDED_MOVE_AWAY",
@@ -27,6 +29,7 @@ __all__ = [
     "LAW_FORCE_TRACKING",
     "LAW_NAMES",
     "LAW_NONE",
+    "LAW_PATH",
     "LAW_SPRING",
     "LINEAR_AXES",
     "N_AXES",
@@ -53,12 +56,15 @@ LAW_SPRING = 2
 LAW_COMPLIANT_MOVE = 3
 # compliant_control_msgs/AxisLaw FORCE_TRACKING: offered through ConfigureLaws only (ControlLaw stops at 3)
 LAW_FORCE_TRACKING = 4
+# compliant_control_msgs/AxisLaw PATH: follows ~path_reference (a replay), ConfigureLaws only
+LAW_PATH = 5
 LAW_NAMES = {
     LAW_NONE: "none",
     LAW_FOLLOWER: "follower",
     LAW_SPRING: "spring",
     LAW_COMPLIANT_MOVE: "compliant_move",
     LAW_FORCE_TRACKING: "force_tracking",
+    LAW_PATH: "path",
 }
 
 # compliant_control_msgs/AxisState end conditions
@@ -69,6 +75,8 @@ END_DIFF_VIOLATION = 3
 END_NO_FT_DATA = 4
 END_EXTERNAL_STOP = 5
 END_OSCILLATION = 6
+END_PATH_LOST = 7
+END_PATH_ERROR = 8
 END_NAMES = {
     END_NONE: "none",
     END_FT_VIOLATION: "force/torque limit",
@@ -77,6 +85,8 @@ END_NAMES = {
     END_NO_FT_DATA: "no F/T data",
     END_EXTERNAL_STOP: "external stop",
     END_OSCILLATION: "oscillation",
+    END_PATH_LOST: "path reference lost",
+    END_PATH_ERROR: "path error",
 }
 
 # compliant_control_msgs/AxisLaw ACTION_*: what an axis does once the move ends on a force/torque limit

@@ -36,9 +36,12 @@ from contact_control.axes import (
     END_NO_FT_DATA,
     END_NONE,
     END_OSCILLATION,
+    END_PATH_ERROR,
+    END_PATH_LOST,
     LAW_FOLLOWER,
     LAW_FORCE_TRACKING,
     LAW_NONE,
+    LAW_PATH,
     LAW_SPRING,
     SAFETY_NAN,
     SAFETY_OK,
@@ -48,11 +51,12 @@ from contact_control.axes import (
 )
 from contact_control.drift import ZeroDrift
 from contact_control.exceeded import ExceededReaction
-from contact_control.laws import AxisLaw, ForceWindow, check_end, law_velocity, shape_velocity
+from contact_control.laws import AxisLaw, ForceWindow, check_end, law_velocity, path_velocity, shape_velocity
 from contact_control.loop_gain import GainBound
 from contact_control.noise_floor import NoiseFloor
 from contact_control.oscillation import OscillationWatch, halved
 from contact_control.params import ContactControlSettings
+from contact_control.path_ref import PathReference
 from contact_control.preprocess import Matrix, PreprocessError, WrenchPreprocessor, as_rows, is_finite6
 from contact_control.rate import SamplePeriod
 from contact_control.request import FAILURE, SET_CONTROL_FORCE_FAILED, RequestError
@@ -207,7 +211,13 @@ class ContactControl:
         self._active: tuple[int, ...] = ()
         self._diff_axes: tuple[int, ...] = ()
         self._needs_travel = False
-        self._floor = [True] * 6  # per axis: zero commands below min velocity (not for force tracking)
+        self._floor = [True] * 6  # per axis: zero commands below min velocity (not for force tracking, path)
+        self._path = PathReference(s.path_reference_timeout, s.path_extrapolate)
+        self._path_axes: tuple[int, ...] = ()
+        self._is_path = [False] * 6
+        self._watched: tuple[int, ...] = ()  # the oscillation watchdog's axes (not a path: it may turn)
+        self._path_error = [0.0] * 6
+        self._path_velocity = [0.0] * 6
         self._v = [0.0] * 6
         self._travel = [0.0] * 6
         self._wrench = [0.0] * 6
@@ -403,7 +413,10 @@ class ContactControl:
         self._active = tuple(i for i in range(6) if laws[i].law != LAW_NONE)
         self._diff_axes = tuple(i for i in self._active if self._diff[i] > 0.0)
         self._needs_travel = any(law.law not in _NO_TRAVEL or law.max_travel > 0.0 for law in laws if law.law)
-        self._floor = [law.law != LAW_FORCE_TRACKING for law in laws]
+        self._floor = [law.law not in (LAW_FORCE_TRACKING, LAW_PATH) for law in laws]
+        self._is_path = [law.law == LAW_PATH for law in laws]
+        self._path_axes = tuple(i for i in self._active if self._is_path[i])
+        self._watched = tuple(i for i in self._active if not self._is_path[i])
         self._watch_floor_update()
 
     def _change_laws(self, laws: list[AxisLaw], t: float | None) -> int:
@@ -457,6 +470,12 @@ class ContactControl:
                 note += f" Hz; lp_filter_delta_t says {configured} s, {1.0 / configured:.4g}"
             note += " Hz"
             self.notes.append(f"{note}); stale after {self._timeout:.3g} s")
+
+    def set_path_reference(self, position: Sequence[float], quaternion: Sequence[float],
+                           twist: Sequence[float], t: float) -> str:
+        """The path law's reference at time `t` [s] (fixed frame; see `path_ref.PathReference.set`): '' or why
+        it is refused."""
+        return self._path.set(position, quaternion, twist, t)
 
     def clock_jumped(self, t: float, description: str) -> CycleResult:
         """The clock jumped (see compliant_common.clock): every duration measured across it is wrong, so the
@@ -617,12 +636,20 @@ class ContactControl:
         laws = self._laws
         armed = self._armed
         over = self._over
+        is_path, error = self._is_path, self._path_error
+        if self._path_axes:
+            if eef_pose is None or not self._path.error(t, eef_pose, R_fixed_control, error,
+                                                       self._path_velocity):
+                return self._end_and_hold(t, self._path_axes[0], END_PATH_LOST)
+            for i in self._path_axes:
+                if 0.0 < laws[i].max_travel <= abs(error[i]):
+                    return self._end_and_hold(t, i, END_PATH_ERROR)
         for i in self._active:
-            end = check_end(laws[i], w[i] if armed[i] else 0.0, travel[i])
+            end = check_end(laws[i], w[i] if armed[i] else 0.0, 0.0 if is_path[i] else travel[i])
             if end == END_FT_VIOLATION:
                 over[i] += 1
                 if over[i] < self._limit_samples:  # one spike over the limit is not a contact
-                    end = check_end(laws[i], 0.0, travel[i])
+                    end = check_end(laws[i], 0.0, 0.0 if is_path[i] else travel[i])
             elif over[i]:
                 over[i] = 0
             if end:
@@ -635,12 +662,14 @@ class ContactControl:
         self._last_t = t
         v, tuning, floor = self._v, self._tuning, self._floor
         for i in self._active:
-            v[i] = shape_velocity(
-                law_velocity(laws[i], tuning[i], w[i], travel[i]), v[i], tuning[i], dt, floor[i]
-            )
+            if is_path[i]:
+                target = path_velocity(laws[i], tuning[i], w[i], error[i], self._path_velocity[i])
+            else:
+                target = law_velocity(laws[i], tuning[i], w[i], travel[i])
+            v[i] = shape_velocity(target, v[i], tuning[i], dt, floor[i])
         watch = self._watch
         if watch is not None:
-            for i in self._active:
+            for i in self._watched:
                 if watch.add(i, t, v[i], self._watch_floor[i]):
                     stopped = self._oscillating(t, i)
                     if stopped is not None:
@@ -836,6 +865,13 @@ class ContactControl:
         law, name = self._laws[axis], AXES[axis]
         if condition == END_FT_VIOLATION:
             why = f"|{self._wrench[axis]:.3g}| reached the limit {law.force_limit}"
+        elif condition == END_PATH_LOST:
+            age = self._path.age(t)
+            why = ("no ~path_reference received" if age == math.inf else
+                   f"no ~path_reference for {age:.2f} s (path_reference_timeout {self._path.timeout:g} s)")
+        elif condition == END_PATH_ERROR:
+            unit = "rad" if axis >= 3 else "m"
+            why = f"|{self._path_error[axis]:.4g}| {unit} from the path reached max_travel {law.max_travel:g}"
         elif condition == END_MAX_TRAVEL:
             why = f"travel |{self._travel[axis]:.4g}| reached the max path deviation {law.max_travel}"
         else:

@@ -16,6 +16,9 @@ the law was set [m] ([rad]), V the commanded velocity [m/s] ([rad/s]):
   corrections are slow ones). Out of contact (F short of `contact_fraction` of the target, on the target's
   side) the axis approaches at least at the law's approach speed (`velocity`) toward the contact, since
   (F - F_target) / b with a b fit for a stiff surface would creep for a long time through free air.
+- path: V = v_ref + k e (+ F / b when b > 0, outside the follower's deadband), e the pose error to a reference
+  that moves (a replay streams it, `path_ref.PathReference`): a spring whose anchor travels along the path,
+  with the path's velocity fed forward. `max_travel` bounds |e| (PATH_ERROR).
 - none: V = 0.
 
 `shape_velocity` then zeroes |V| <= min_velocity, clamps to the max velocity and limits acceleration and
@@ -42,7 +45,9 @@ from contact_control.axes import (
 )
 from contact_control.params import AxisTuning
 
-__all__ = ["AxisLaw", "ForceWindow", "check_end", "law_velocity", "round_to", "shape_velocity"]
+__all__ = [
+    "AxisLaw", "ForceWindow", "check_end", "law_velocity", "path_velocity", "round_to", "shape_velocity",
+]
 
 
 @dataclass(frozen=True)
@@ -118,6 +123,15 @@ def law_velocity(law: AxisLaw, tuning: AxisTuning, force: float, travel: float) 
             return max(v, law.velocity)
         return v
     return 0.0
+
+
+def path_velocity(law: AxisLaw, tuning: AxisTuning, force: float, error: float, reference: float) -> float:
+    """The path law's velocity before shaping: V = v_ref + k e, plus F / b outside the follower's deadband
+    when b > 0 (a push moves the tool off the path, the spring to the moving reference brings it back)."""
+    v = reference + law.stiffness * error
+    if law.damping > 0.0 and not -tuning.deadband <= force <= tuning.deadband:
+        v += force / law.damping
+    return v
 
 
 def shape_velocity(

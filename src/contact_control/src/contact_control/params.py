@@ -254,6 +254,13 @@ class ContactControlSettings:
         doc="force tracking is out of contact, and approaches at least at its approach speed, while F is "
         "short of this fraction of the target",
     )
+    # path law (ConfigureLaws PATH, fed by ~path_reference)
+    path_reference_timeout: float = _pos(
+        0.25, "s", "a path law's move ends (PATH_LOST) when no ~path_reference came for this long"
+    )
+    path_extrapolate: float = _nonneg(
+        0.05, "s", "a reference's position moves on with its velocity for at most this long after it came"
+    )
     # contact events (~events) and hand-guiding (~guide)
     event_touch_force: float = _pos(
         3.0, "N", "|F| (preprocessed contact force, control frame) at which ~events reports a touch (above a "

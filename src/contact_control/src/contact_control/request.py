@@ -38,6 +38,7 @@ from contact_control.axes import (
     LAW_FORCE_TRACKING,
     LAW_NAMES,
     LAW_NONE,
+    LAW_PATH,
     LAW_SPRING,
 )
 from contact_control.laws import AxisLaw
@@ -227,6 +228,9 @@ def _axis_law(
         where = f"{name.upper()} reads {names[key]}; got {values[key]}"
         return RequestError(code, f"axis {name} ({LAW_NAMES.get(law, law)}): {what}; {where}", name)
 
+    if law == LAW_PATH and target is None:
+        raise fail(SET_DOF_FAILED, "the path law (5) is offered through compliant_control_msgs/ConfigureLaws "
+                   "only", "law")
     if law == LAW_FORCE_TRACKING and target is None:
         raise fail(
             SET_DOF_FAILED,
@@ -235,8 +239,8 @@ def _axis_law(
             "law",
         )
     if law not in LAW_NAMES:
-        known = "0 none, 1 follower, 2 spring, 3 compliant move" + (", 4 force tracking" if target is not None
-                                                                     else "")
+        known = "0 none, 1 follower, 2 spring, 3 compliant move" + (", 4 force tracking, 5 path"
+                                                                     if target is not None else "")
         raise fail(SET_DOF_FAILED, f"unknown law type {law} ({known})", "law")
     if law == LAW_NONE:
         return AxisLaw()
@@ -275,6 +279,16 @@ def _axis_law(
                            "v")
             cap = v
         return AxisLaw(LAW_FOLLOWER, damping=b, velocity=cap, force_limit=limit, max_travel=travel,
+                       exceeded_action=action)
+    if law == LAW_PATH:
+        if not (k > 0.0 and math.isfinite(k)):
+            raise fail(SET_FORCE_STIFFNESS_FAILED, "path gain k must be finite and > 0 (1/s)", "k")
+        if not (b >= 0.0 and math.isfinite(b)):
+            raise fail(SET_CARTESIAN_CONTROL_FAILED, "damping b must be finite, >= 0 (0: no force term)", "b")
+        if action == EXCEEDED_GRAVITY_COMPENSATION and b == 0.0:
+            raise fail(SET_CARTESIAN_CONTROL_FAILED, "gravity_compensation makes the axis a follower "
+                       "(V = F / b) after its force limit: damping b must be > 0", "b")
+        return AxisLaw(LAW_PATH, damping=b, stiffness=k, force_limit=limit, max_travel=travel,
                        exceeded_action=action)
     if law == LAW_FORCE_TRACKING:
         assert target is not None  # refused above

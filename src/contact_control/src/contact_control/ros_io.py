@@ -21,7 +21,7 @@ from cartesian_impedance_msgs.srv import (
     ConfigureForceControlResponse,
 )
 from compliant_common.ros_time import TimerEvent, timer
-from compliant_control_msgs.msg import AxisState, ContactControlStatus, ContactEvent
+from compliant_control_msgs.msg import AxisState, ContactControlStatus, ContactEvent, PathReference
 from compliant_control_msgs.srv import (
     ConfigureLaws,
     ConfigureLawsRequest,
@@ -131,6 +131,8 @@ class ContactControlRos:
                                             tcp_nodelay=True)
         # Rare (a touch, a move's end): published from the cycle that found them, latched for late joiners.
         self._events_pub = rospy.Publisher(private_ns + "events", ContactEvent, queue_size=20, latch=True)
+        self._path_sub = rospy.Subscriber(private_ns + "path_reference", PathReference,
+                                          self._on_path_reference, queue_size=1, tcp_nodelay=True)
         self._status_msg = ContactControlStatus(axes=[AxisState(axis=name) for name in AXES])
         self._status_msg.header.frame_id = s.control_frame
         # Service names in the node's namespace (not private), as the original served them.
@@ -239,6 +241,20 @@ class ContactControlRos:
             (rospy.loginfo if answer.ok else rospy.logwarn)("contact_control: %s", answer.message)
             self.emit_locked(zero, t)
         return GuideResponse(success=answer.ok, code=answer.code, message=answer.message)
+
+    def _on_path_reference(self, msg: PathReference) -> None:
+        """The path law's reference (fixed frame), timed by its arrival on this node's clock."""
+        frame = msg.header.frame_id
+        if frame and frame.lstrip("/") != self._s.fixed_frame:
+            rospy.logwarn_throttle(5.0, "contact_control: ~path_reference in %s ignored: it must be in %s",
+                                   frame, self._s.fixed_frame)
+            return
+        p, q, v, w = msg.pose.position, msg.pose.orientation, msg.velocity.linear, msg.velocity.angular
+        with self._lock:
+            why = self._stage.ctrl.set_path_reference((p.x, p.y, p.z), (q.x, q.y, q.z, q.w),
+                                                      (v.x, v.y, v.z, w.x, w.y, w.z), rospy.get_time())
+        if why:
+            rospy.logwarn_throttle(5.0, "contact_control: %s", why)
 
     @staticmethod
     def _response(success: bool) -> ConfigureForceControlResponse:

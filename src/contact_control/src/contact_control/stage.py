@@ -21,6 +21,7 @@ from contact_control.axes import (
     LAW_FOLLOWER,
     LAW_FORCE_TRACKING,
     LAW_NAMES,
+    LAW_PATH,
     SAFETY_NO_TF,
 )
 from contact_control.controller import ContactControl, CycleResult
@@ -368,6 +369,10 @@ def describe_laws(move_id: int, laws: Sequence[AxisLaw]) -> str:
                 notes = [f"target {law.target:g}", f"b {law.damping:g}", f"approach {law.velocity:g}"]
             if law.exceeded_action:
                 notes.append(EXCEEDED_ACTION_NAMES[law.exceeded_action])
+            if law.law == LAW_PATH:
+                notes = [f"k {law.stiffness:g}", f"b {law.damping:g}"]
+                if law.max_travel:
+                    notes.append(f"max error {law.max_travel:g}")
             if law.law == LAW_FOLLOWER and law.velocity > 0.0:
                 notes.insert(0, f"at most {law.velocity:g}")
             parts.append(f"{AXES[i]}={LAW_NAMES[law.law]}" + (f" ({', '.join(notes)})" if notes else ""))

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import threading
 import time
+from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
@@ -17,7 +18,13 @@ import rosgraph
 import rospy
 import yaml
 from compliant_control_msgs.msg import ContactControlStatus
-from compliant_control_msgs.srv import MoveToNamedPose, MoveToNamedPoseResponse
+from compliant_control_msgs.srv import (
+    MoveToJoints,
+    MoveToJointsRequest,
+    MoveToJointsResponse,
+    MoveToNamedPose,
+    MoveToNamedPoseResponse,
+)
 from controller_manager_msgs.srv import ListControllers, SwitchController, SwitchControllerRequest
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
@@ -75,6 +82,7 @@ class NamedPoseServer:
         rospy.Subscriber(settings.contact_control_status,
                          ContactControlStatus, self._on_status, queue_size=1)
         rospy.Service("~move_to", MoveToNamedPose, self._move_to)
+        rospy.Service("~move_to_joints", MoveToJoints, self._move_to_joints)
         rospy.loginfo(
             "named_pose_server: poses %s for joints %s", sorted(self.poses.poses), list(self.poses.joints)
         )
@@ -138,19 +146,35 @@ class NamedPoseServer:
         if not self._busy.acquire(blocking=False):
             return self._refuse("another named-pose move is running")
         try:
-            return self._run(req)
+            return self._run(repr(req.name), req.speed_scale,
+                             lambda current: self.poses.goal(req.name, current))
         finally:
             self._busy.release()
+
+    def _move_to_joints(self, req: MoveToJointsRequest) -> MoveToJointsResponse:
+        """compliant_control_msgs/MoveToJoints: the same move to given joint positions (a program's start)."""
+        if not self._busy.acquire(blocking=False):
+            return MoveToJointsResponse(success=False, message="another named-pose move is running")
+        label = req.label or "the given joint positions"
+        try:
+            answer = self._run(label, req.speed_scale,
+                               lambda _current: self.poses.goal_of(req.joint_names, req.positions, label))
+        finally:
+            self._busy.release()
+        return MoveToJointsResponse(success=answer.success, message=answer.message)
 
     @staticmethod
     def _refuse(reason: str) -> MoveToNamedPoseResponse:
         rospy.logwarn("named_pose_server: refused: %s", reason)
         return MoveToNamedPoseResponse(success=False, message=reason)
 
-    def _run(self, req: MoveToNamedPose) -> MoveToNamedPoseResponse:
-        scale = req.speed_scale or 1.0
+    def _run(
+        self, name: str, speed_scale: float, make_goal: Callable[[np.ndarray], np.ndarray]
+    ) -> MoveToNamedPoseResponse:
+        """A joint move to `make_goal(current)` (named `name` in the answers and the log)."""
+        scale = speed_scale or 1.0
         if not 0.0 < scale <= 1.0:
-            return self._refuse(f"speed_scale must be in (0, 1], got {req.speed_scale}")
+            return self._refuse(f"speed_scale must be in (0, 1], got {speed_scale}")
         running = self._contact_move_running()
         if running is None:
             return self._refuse(
@@ -169,7 +193,7 @@ class NamedPoseServer:
                 f"(is the driver publishing {self._states_topic}?)"
             )
         try:
-            goal = self.poses.goal(req.name, current)
+            goal = make_goal(current)
             move = plan_move(
                 current, goal, self.poses.max_velocity * scale, self.poses.max_acceleration * scale
             )
@@ -193,7 +217,7 @@ class NamedPoseServer:
                 return self._refuse(str(exc) + self._resume_jog(paused))
         back = _Switched(True, "")
         try:
-            answer = self._move(req.name, goal, move.duration, msg)
+            answer = self._move(name, goal, move.duration, msg)
         finally:
             if switch is not None:
                 back = self._switch(switch.undo())
@@ -237,18 +261,18 @@ class NamedPoseServer:
         """Sends the trajectory and waits for the arm to arrive."""
         if duration > 0.0:
             self._pub.publish(msg)  # stamp 0: the driver starts it now
-        rospy.loginfo("named_pose_server: to %r in %.2f s", name, duration)
+        rospy.loginfo("named_pose_server: to %s in %.2f s", name, duration)
         deadline = time.monotonic() + duration + self.settle_time
         while time.monotonic() < deadline and not rospy.is_shutdown():
             now = self._current()
             if now is not None and float(np.max(np.abs(now - goal))) <= self.tolerance:
                 return MoveToNamedPoseResponse(
-                    success=True, message=f"at {name!r} after a {duration:.2f} s move"
+                    success=True, message=f"at {name} after a {duration:.2f} s move"
                 )
             time.sleep(0.01)
         now = self._current()
         error = float(np.max(np.abs(now - goal))) if now is not None else float("nan")
-        return self._refuse(f"did not reach {name!r}: largest joint error {error:.3f} rad")
+        return self._refuse(f"did not reach {name}: largest joint error {error:.3f} rad")
 
     # --- controller switching (switching.py; README, Controller switching) ---
     def _switch_on(self) -> Switch | None:

@@ -107,6 +107,8 @@ class NamedPoses:
     max_velocity: np.ndarray
     max_acceleration: np.ndarray
     continuous: tuple[bool, ...]
+    lower: tuple[float, ...] = ()  # per joint [rad] (the URDF's; () unchecked)
+    upper: tuple[float, ...] = ()
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], urdf: Mapping[str, UrdfJoint]) -> NamedPoses:
@@ -155,7 +157,29 @@ class NamedPoses:
         acceleration = _per_joint(
             data.get("max_acceleration", _DEFAULTS.max_acceleration), "max_acceleration", joints
         )
-        return cls(joints, arrays, velocity, acceleration, tuple(urdf[j].continuous for j in joints))
+        return cls(joints, arrays, velocity, acceleration, tuple(urdf[j].continuous for j in joints),
+                   tuple(urdf[j].lower for j in joints), tuple(urdf[j].upper for j in joints))
+
+    def goal_of(
+        self, names: Sequence[str], positions: Sequence[float], label: str = "the goal"
+    ) -> np.ndarray:
+        """The angles [rad] of `self.joints` taken from `names`/`positions` (other joints ignored).
+
+        Raises:
+            PoseError: Lengths differ, a joint is missing, a value is not finite or outside its limits.
+        """
+        if len(names) != len(positions):
+            raise PoseError(f"{label}: {len(names)} joint names but {len(positions)} positions")
+        given = dict(zip(names, positions, strict=True))
+        missing = [j for j in self.joints if j not in given]
+        if missing:
+            raise PoseError(f"{label}: no position for {missing} (the arm's joints are {list(self.joints)})")
+        goal = np.array([float(given[j]) for j in self.joints])
+        for i, joint in enumerate(self.joints):
+            lo, hi = (self.lower[i], self.upper[i]) if self.lower else (-math.inf, math.inf)
+            if not (math.isfinite(goal[i]) and lo <= goal[i] <= hi):
+                raise PoseError(f"{label}: {joint} {goal[i]} rad is outside the joint's limits [{lo}, {hi}]")
+        return goal
 
     def goal(self, name: str, current: Sequence[float] | np.ndarray) -> np.ndarray:
         """The pose's angles [rad], continuous joints moved to the equivalent nearest `current`.

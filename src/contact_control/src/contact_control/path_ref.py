@@ -1,0 +1,85 @@
+"""The moving reference of the path law (LAW_PATH): a pose and a twist in the fixed frame, streamed by a
+replay.
+
+V = v_ref + k e (+ F / b): `PathReference.error` gives, per control axis, the pose error e (reference minus
+end
+effector: position [m], rotation vector [rad]) and v_ref, both along the control axes. The reference is held
+for `timeout` after its stamp (its position extrapolated with its velocity for at most `extrapolate` s); an
+older one is lost, and the move ends (the replay stopped sending). No ROS here.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+from contact_control.frames import quaternion_matrix
+from contact_control.preprocess import Matrix, as_rows
+from contact_control.travel import rotation_vector
+
+__all__ = ["PathReference"]
+
+_IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
+class PathReference:
+    """The latest reference; see the module docstring.
+
+    Args:
+        timeout: a reference older than this [s] is lost.
+        extrapolate: its position moves on with its velocity for at most this long [s].
+    """
+
+    def __init__(self, timeout: float, extrapolate: float) -> None:
+        self.timeout = timeout
+        self.extrapolate = extrapolate
+        self._t: float | None = None
+        self._p = (0.0, 0.0, 0.0)
+        self._r: list[list[float]] = [list(row) for row in _IDENTITY]
+        self._v = (0.0,) * 6
+
+    @property
+    def received(self) -> bool:
+        return self._t is not None
+
+    def clear(self) -> None:
+        self._t = None
+
+    def set(self, position: Sequence[float], quaternion: Sequence[float], twist: Sequence[float],
+            t: float) -> str:
+        """A new reference at time `t` [s]: position [m], quaternion (x, y, z, w), twist (vx..wz) [m/s, rad/s]
+        in the fixed frame. Returns '' or why it is refused (not finite, not a rotation)."""
+        values = (*position, *quaternion, *twist, t)
+        sizes = (len(position), len(quaternion), len(twist))
+        if sizes != (3, 4, 6) or not all(map(math.isfinite, values)):
+            return "path reference: expected finite position (3), quaternion (4) and twist (6)"
+        if abs(sum(q * q for q in quaternion) - 1.0) > 0.01:
+            return "path reference: the quaternion is not a unit quaternion"
+        self._p = (float(position[0]), float(position[1]), float(position[2]))
+        self._r = quaternion_matrix(*quaternion)
+        self._v = tuple(float(x) for x in twist)  # type: ignore[assignment]
+        self._t = t
+        return ""
+
+    def age(self, t: float) -> float:
+        return math.inf if self._t is None else t - self._t
+
+    def error(self, t: float, T_fixed_eef: Matrix, R_fixed_control: Matrix | None,
+              error: list[float], velocity: list[float]) -> bool:
+        """Writes e and v_ref along the control axes at `t`; False (nothing written) when the reference is
+        missing or older than `timeout`."""
+        if self._t is None or t - self._t > self.timeout:
+            return False
+        m = as_rows(T_fixed_eef)
+        dt = min(max(t - self._t, 0.0), self.extrapolate)
+        p, v, r = self._p, self._v, self._r
+        e = [p[i] + v[i] * dt - m[i][3] for i in range(3)]
+        # R_ref R_eef^T: the rotation still to go, in the fixed frame.
+        rd = [[r[i][0] * m[j][0] + r[i][1] * m[j][1] + r[i][2] * m[j][2] for j in range(3)] for i in range(3)]
+        e.extend(rotation_vector(rd))
+        rc = _IDENTITY if R_fixed_control is None else as_rows(R_fixed_control)
+        for k in (0, 3):
+            for i in range(3):  # Rc^T x: along the control axes
+                error[k + i] = rc[0][i] * e[k] + rc[1][i] * e[k + 1] + rc[2][i] * e[k + 2]
+                velocity[k + i] = rc[0][i] * v[k] + rc[1][i] * v[k + 1] + rc[2][i] * v[k + 2]
+        return True

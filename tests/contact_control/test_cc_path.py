@@ -1,0 +1,116 @@
+"""The path law (LAW_PATH, contact_control.path_ref): a moving reference followed with its velocity fed
+forward, compliant to a push, ending when the reference stops coming or the error grows too large."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from contact_control.axes import END_PATH_ERROR, END_PATH_LOST, LAW_PATH
+from contact_control.laws import AxisLaw
+from contact_control.request import (
+    RequestError,
+    empty_laws_request,
+    empty_request,
+    validate_laws_request,
+    validate_request,
+)
+
+from .cc_sim import DT, ClosedLoop, controller, laws
+
+SPEED = 0.02  # [m/s] along X
+
+
+def path(k: float = 5.0, b: float = 0.0, max_error: float = 0.0) -> list[AxisLaw]:
+    return laws(x=AxisLaw(LAW_PATH, damping=b, stiffness=k, max_travel=max_error),
+                y=AxisLaw(LAW_PATH, damping=b, stiffness=k), z=AxisLaw(LAW_PATH, damping=b, stiffness=k))
+
+
+def feed(loop: ClosedLoop, x0: float, t0: float):
+    """A reference moving along +X at SPEED from x0 at t0, sent every cycle."""
+
+    def wrench(t, pose):
+        x = x0 + SPEED * (t - t0)
+        loop.ctrl.set_path_reference((x, 0.0, 0.0), (0, 0, 0, 1), (SPEED, 0, 0, 0, 0, 0), t)
+        return (0.0,) * 6
+
+    return wrench
+
+
+def test_a_moving_reference_is_followed_within_a_fraction_of_a_millimetre():
+    ctrl = controller(lp_filter_enabled=False, acceleration_linear=0.4)
+    loop = ClosedLoop(ctrl, lag=0.02)
+    ctrl.set_path_reference((0, 0, 0), (0, 0, 0, 1), (0,) * 6, 0.0)
+    loop.start(path())
+    result = loop.run(feed(loop, 0.0, 0.0), 3.0)
+    assert result.move_active and result.laws[0] == LAW_PATH
+    x_ref = SPEED * loop.t
+    assert loop.pose[0, 3] == pytest.approx(x_ref, abs=3e-4)  # 20 ms of lag, fed forward: ~0.1 mm behind
+    assert abs(loop.pose[1, 3]) < 1e-6 and abs(loop.pose[2, 3]) < 1e-6
+    assert result.velocity[0] == pytest.approx(SPEED, abs=1e-3)
+
+
+def test_an_offset_start_converges_at_the_gain_and_a_push_gives_way_when_b_is_set():
+    ctrl = controller(lp_filter_enabled=False)
+    loop = ClosedLoop(ctrl)
+    ctrl.set_path_reference((0.01, 0, 0), (0, 0, 0, 1), (0,) * 6, 0.0)
+    loop.start(path(k=5.0, b=100.0))
+
+    def hold(t, pose, push=0.0):
+        ctrl.set_path_reference((0.01, 0, 0), (0, 0, 0, 1), (0,) * 6, t)
+        return (0.0, push, 0.0, 0.0, 0.0, 0.0)
+
+    loop.run(hold, 2.0)
+    assert loop.pose[0, 3] == pytest.approx(0.01, abs=2e-4)
+    loop.run(lambda t, pose: hold(t, pose, 10.0), 2.0)  # 10 N along +Y: equilibrium F / (b k) = 20 mm
+    assert loop.pose[1, 3] == pytest.approx(10.0 / (100.0 * 5.0), abs=2e-3)
+    loop.run(hold, 3.0)  # released: back on the path
+    assert abs(loop.pose[1, 3]) < 5e-4
+
+
+def test_the_move_ends_when_the_reference_stops_coming_or_the_error_grows_too_large():
+    ctrl = controller(lp_filter_enabled=False, path_reference_timeout=0.1)
+    loop = ClosedLoop(ctrl)
+    ctrl.set_path_reference((0, 0, 0), (0, 0, 0, 1), (0,) * 6, 0.0)
+    loop.start(path())
+    result = loop.run((0.0,) * 6, 0.2)  # nobody sends: lost after 0.1 s
+    assert not result.move_active and result.end_conditions[0] == END_PATH_LOST
+    assert "no ~path_reference for" in ctrl.end_message
+
+    ctrl = controller(lp_filter_enabled=False)
+    loop = ClosedLoop(ctrl)
+    ctrl.set_path_reference((0, 0, 0), (0, 0, 0, 1), (0,) * 6, 0.0)
+    loop.start(path(max_error=0.005))
+
+    def jump(t, pose):  # the reference runs away at 0.1 m/s while the arm is held (lag of a blocked tool)
+        ctrl.set_path_reference((0.1 * t, 0, 0), (0, 0, 0, 1), (0,) * 6, t)
+        return (0.0,) * 6
+
+    result = loop.run(jump, 0.5)
+    assert not result.move_active and result.end_conditions[0] == END_PATH_ERROR
+    assert "from the path reached max_travel 0.005" in ctrl.end_message
+
+
+def test_orientation_error_is_a_rotation_vector_along_the_control_axes():
+    ctrl = controller(lp_filter_enabled=False)
+    pose = np.eye(4)
+    turned = (0.0, 0.0, np.sin(0.05), np.cos(0.05))  # 0.1 rad about Z
+    ctrl.set_path_reference((0, 0, 0), turned, (0,) * 6, 0.0)
+    ctrl.set_laws(laws(rz=AxisLaw(LAW_PATH, stiffness=2.0)), pose, 0.0)
+    result = None
+    for i in range(50):
+        result = ctrl.update((0.0,) * 6, (i + 1) * DT, eef_pose=pose)
+    assert result is not None and result.velocity[5] == pytest.approx(0.2, abs=1e-6)  # k e = 2 x 0.1
+
+
+def test_requests_path_through_configure_laws_only_with_a_gain():
+    req = empty_laws_request()
+    req.x.law, req.x.stiffness, req.x.damping, req.x.max_travel = 5, 4.0, 200.0, 0.02
+    (x, *_rest) = validate_laws_request(req)
+    assert x.law == LAW_PATH and x.stiffness == 4.0 and x.max_travel == 0.02
+    req.x.stiffness = 0.0
+    with pytest.raises(RequestError, match="path gain k"):
+        validate_laws_request(req)
+    old = empty_request()
+    old.direction_control_laws.x.type = 5
+    with pytest.raises(RequestError, match="ConfigureLaws only"):
+        validate_request(old)
