@@ -333,11 +333,12 @@ class ContactControlRos:
     def _on_status(self, _event: TimerEvent | None) -> None:
         if self._status_pub.get_num_connections() == 0:  # nobody listening: save the work
             return
-        with self._lock:
+        with self._lock:  # stamped under the lock: no status older than a request is stamped after its answer
+            stamp = rospy.Time.now()
             r, message = self._stage.status()
             guiding = self._stage.guiding
         msg = self._status_msg  # reused: the status timer allocates nothing per cycle
-        msg.header.stamp = rospy.Time.now()
+        msg.header.stamp = stamp
         msg.move_active = r.move_active
         msg.guiding = guiding
         msg.safety = r.safety

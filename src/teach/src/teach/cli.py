@@ -4,12 +4,15 @@
     teach record NAME [--keep-bag] [--overwrite] [--no-wait]  (Enter: keyframe, q + Enter: stop, save)
     teach keyframe | stop
     teach list | show NAME | delete NAME
+    teach replay NAME [--speed 0.5] [--press-z 10]   (Ctrl-C cancels)
+    teach pause | resume
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import time
 from collections.abc import Callable, Sequence
 
 __all__ = ["main"]
@@ -33,9 +36,60 @@ def _parser() -> argparse.ArgumentParser:
     sub.add_parser("keyframe", help="mark a keyframe in the running recording")
     sub.add_parser("stop", help="stop the recording and save the program")
     sub.add_parser("list", help="the saved programs")
+    replay = sub.add_parser("replay", help="play a program back with compliance (Ctrl-C cancels)")
+    replay.add_argument("name")
+    replay.add_argument("--speed", type=float, default=1.0, help="the recorded speed times this (default 1)")
+    for axis in ("x", "y", "z"):
+        replay.add_argument(f"--press-{axis}", type=float, metavar="N", default=None,
+                            help=f"press along {axis} with this force [N] (instead of following the path)")
+    sub.add_parser("pause", help="pause the running replay (the tool holds its pose)")
+    sub.add_parser("resume", help="resume a paused replay")
     for name, what in (("show", "print a program's YAML"), ("delete", "delete a program")):
         sub.add_parser(name, help=what).add_argument("name")
     return parser
+
+
+def _replay(args: argparse.Namespace, node: str) -> int:
+    """Sends the goal, prints the feedback twice a second and the result; Ctrl-C cancels."""
+    import actionlib
+    import rospy
+    from compliant_control_msgs.msg import ReplayProgramAction, ReplayProgramGoal
+
+    press = [(axis, getattr(args, f"press_{axis}")) for axis in ("x", "y", "z")
+             if getattr(args, f"press_{axis}") is not None]
+    if len(press) > 1:
+        print("teach: press along one axis at most", file=sys.stderr)
+        return 2
+    axis, force = press[0] if press else ("", 0.0)
+    client = actionlib.SimpleActionClient(f"{node}/replay", ReplayProgramAction)
+    if not client.wait_for_server(rospy.Duration(5.0)):
+        print(f"teach: {node}/replay: no action server (is the stack running?)", file=sys.stderr)
+        return 1
+    shown = [0.0]
+
+    def feedback(fb: object) -> None:
+        now = time.monotonic()
+        if now - shown[0] >= 0.5:
+            shown[0] = now
+            print(f"{fb.state}: {fb.progress:.0%}, path error {fb.path_error * 1e3:.1f} mm, "  # type: ignore[attr-defined]
+                  f"force {fb.force:.1f} N", flush=True)  # type: ignore[attr-defined]
+
+    client.send_goal(ReplayProgramGoal(name=args.name, speed=args.speed, press_axis=axis, press_force=force),
+                     feedback_cb=feedback)
+    try:
+        client.wait_for_result()
+    except KeyboardInterrupt:
+        client.cancel_goal()
+        client.wait_for_result(rospy.Duration(10.0))
+    result = client.get_result()
+    if result is None:
+        print("teach: no result from the replay", file=sys.stderr)
+        return 1
+    for event in result.contacts:
+        p = event.pose.pose.position
+        print(f"  {event.type_name} at ({p.x:.3f}, {p.y:.3f}, {p.z:.3f}) m: {event.message}")
+    print(result.message, file=sys.stdout if result.success else sys.stderr)
+    return 0 if result.success else 1
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -64,6 +118,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     commands: dict[str, Callable[[], int]] = {
         "guide": lambda: answer(call(f"{cc}/guide", Guide, enable=args.state == "on", axes=args.axes)),
         "keyframe": lambda: answer(call(f"{node}/keyframe", Trigger)),
+        "pause": lambda: answer(call(f"{node}/pause", Trigger)),
+        "resume": lambda: answer(call(f"{node}/resume", Trigger)),
+        "replay": lambda: _replay(args, node),
         "stop": lambda: answer(call(f"{node}/stop", Trigger)),
         "show": lambda: answer(call(f"{node}/show", ProgramCommand, name=args.name)),
         "delete": lambda: answer(call(f"{node}/delete", ProgramCommand, name=args.name)),

@@ -34,6 +34,7 @@ from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 from teach.params import TeachParamError, TeachSettings, load_settings
 from teach.program import ProgramError, ProgramStore, check_name
 from teach.recorder import Recorder
+from teach.replay import ReplayServer
 
 __all__ = ["TeachNode", "main", "robot_name"]
 
@@ -77,12 +78,18 @@ class TeachNode:
             rospy.Service("~show", ProgramCommand, self._on_show),
             rospy.Service("~delete", ProgramCommand, self._on_delete),
         ]
+        self.replay = ReplayServer(s, self.store, robot, base_frame, tip_frame, self._tf, self._listen_tf,
+                                   lambda: self.recorder.recording)
+
+    def _listen_tf(self) -> None:
+        """tf from now on (the first recording or replay starts it; idle before)."""
+        if self._listener is None:
+            self._listener = tf2_ros.TransformListener(self._tf)
 
     def _listen(self) -> None:
         s = self.settings
         self._joints = self._wrench = None
-        if self._listener is None:
-            self._listener = tf2_ros.TransformListener(self._tf)
+        self._listen_tf()
         self._subs = [
             rospy.Subscriber(s.joint_states_topic, JointState, self._on_joints, queue_size=1),
             rospy.Subscriber(s.wrench_topic, WrenchStamped, self._on_wrench, queue_size=1),

@@ -36,6 +36,61 @@ class TeachSettings:
                                       doc="where the frames' defaults, `~guide` and `~events` are")
     joint_states_topic: str = param("joint_states", nonempty=True, doc="sensor_msgs/JointState input")
     wrench_topic: str = param("wrench", nonempty=True, doc="geometry_msgs/WrenchStamped input (the sensor's)")
+    named_poses_node: str = param(
+        "named_poses", nonempty=True, doc="where `~move_to_joints` is (the move to a program's start)"
+    )
+    start_speed_scale: float = param(0.5, gt=0.0, le=1.0, doc="speed_scale of the move to a program's start")
+    replay_rate: float = param(
+        100.0, unit="Hz", gt=0.0, le=1000.0, doc="rate of the path reference streamed to contact_control"
+    )
+    replay_max_speed: float = param(4.0, gt=0.0, doc="the largest speed factor a replay accepts")
+    replay_gain: float = param(
+        5.0, unit="1/s", gt=0.0,
+        doc="the path law's k on the path axes (the reference's velocity is fed forward)",
+    )
+    replay_damping_linear: float = param(
+        0.0, unit="N/(m/s)", ge=0.0,
+        doc="the path law's b on X, Y, Z: > 0 lets a push move the tool off the path by F / (b k); 0: stiff",
+    )
+    replay_damping_angular: float = param(0.0, unit="Nm/(rad/s)", ge=0.0, doc="same on RX, RY, RZ")
+    replay_max_path_error: float = param(
+        0.03, unit="m", gt=0.0, doc="a path axis this far from the reference ends the replay (PATH_ERROR)"
+    )
+    replay_max_angle_error: float = param(0.2, unit="rad", gt=0.0, doc="same for rotations")
+    replay_press_damping: float = param(
+        800.0, unit="N/(m/s)", gt=0.0,
+        doc="force tracking b on the press axis: an L on the simulated block at 1 cm/s stayed within "
+        "8.92-10.87 N at 800, 8.46-11.60 N at 2000 (friction turning at the corner); 500 rings "
+        "(contact_control's README, Force tracking)",
+    )
+    replay_press_approach: float = param(
+        0.005, unit="m/s", gt=0.0,
+        doc="pressing, the speed toward the contact until it touches (0.01 m/s overshot to 21 N on the "
+        "simulated arms: the surface-following demonstration's finding)",
+    )
+    replay_force_limit: float = param(
+        20.0, unit="N", gt=0.0,
+        doc="a force over this on a linear axis ends the replay with `replay_exceeded_action`",
+    )
+    replay_torque_limit: float = param(
+        0.0, unit="Nm", ge=0.0,
+        doc="same for torques (0: only contact_control's global limit: a press at the tool tip loads the "
+        "wrist through its lever)",
+    )
+    replay_exceeded_action: int = param(
+        1, choices=(0, 1, 2),
+        doc="after the limit: 0 stop, 1 move_away, 2 gravity_compensation (needs replay damping > 0)",
+    )
+    press_tolerance: float = param(
+        0.1, gt=0.0, lt=1.0,
+        doc="pressing, the path starts once the force has stayed within this fraction of press_force for "
+        "`press_settle_time`",
+    )
+    press_settle_time: float = param(0.5, unit="s", ge=0.0, doc="see `press_tolerance`")
+    press_timeout: float = param(
+        30.0, unit="s", gt=0.0, doc="pressing, no steady contact within this ends the replay"
+    )
+    settle_time: float = param(0.5, unit="s", ge=0.0, doc="the reference holds the last pose this long")
     robot: str = param("", shown_default="robot_description's robot name",
                        doc="the arm's name in programs; a program of another is refused (empty: the default)")
 
