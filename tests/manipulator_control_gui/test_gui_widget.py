@@ -87,6 +87,7 @@ def names_in(ns: str) -> RosNames:
     params = {
         "~contact_control_node": f"{ns}/contact_control_node",
         "~configure_service": f"{ns}/configure_cartesian_impedance",
+        "~teach_node": f"{ns}/teach",
     }
     return RosNames.from_params(lambda key, default: params.get(key, default))
 
@@ -485,3 +486,60 @@ def test_guide_refused_shows_the_reason(ns, make_widget, pump, ros_node):
         assert widget.answer_label.text().startswith("Guide refused: hand-guiding refused")
     finally:
         refusing.close()
+
+
+class FakeTeach:
+    """teach's program_server shaped services and replay action, recording what the panel sends."""
+
+    def __init__(self, rospy, ns: str) -> None:
+        import actionlib
+        from compliant_control_msgs.msg import ReplayProgramAction, ReplayProgramResult
+        from compliant_control_msgs.srv import RecordProgram, RecordProgramResponse
+
+        self.calls: list = []
+        node = f"{ns}/teach"
+        self.services = [
+            rospy.Service(f"{node}/record", RecordProgram, lambda req: (
+                self.calls.append(("record", req.name)),
+                RecordProgramResponse(success=True, message=f"recording '{req.name}' at 50 Hz"))[1]),
+            rospy.Service(f"{node}/stop", Trigger, lambda req: (
+                self.calls.append(("stop",)),
+                TriggerResponse(success=True, message="saved program1: robot ur5, 7 waypoints"))[1]),
+        ]
+
+        def execute(goal) -> None:
+            self.calls.append(("replay", goal.name, goal.speed, goal.press_axis, goal.press_force))
+            self.server.set_succeeded(ReplayProgramResult(success=True, message=f"program '{goal.name}' "
+                                                          "replayed at 1 x its speed; force 10.02 N"))
+
+        self.server = actionlib.SimpleActionServer(f"{node}/replay", ReplayProgramAction, execute,
+                                                   auto_start=False)
+        self.server.start()
+
+    def close(self) -> None:
+        for service in self.services:
+            service.shutdown()
+
+
+def test_teach_box_records_stops_and_replays_through_program_server(fake, ns, make_widget, pump, ros_node):
+    teach = FakeTeach(ros_node, ns)
+    try:
+        widget = make_widget(ns)
+        box = widget.teach_box
+        box.name_edit.setText("l_path")
+        click(box.record_button)
+        pump(lambda: teach.calls == [("record", "l_path")], message="the record call")
+        recording = "Record done: recording 'l_path' at 50 Hz"
+        pump(lambda: widget.answer_label.text() == recording, message="the record answer")
+        click(box.stop_button)
+        pump(lambda: "saved program1" in widget.answer_label.text(), message="the stop answer")
+        box.speed_spin.setValue(0.5)
+        box.press_spin.setValue(10.0)
+        click(box.replay_button)
+        pump(lambda: len(teach.calls) == 3, timeout=20, message="the replay goal")
+        assert teach.calls[2] == ("replay", "l_path", 0.5, "z", 10.0)
+        pump(lambda: "replayed at 1 x its speed" in widget.answer_label.text(), timeout=20,
+             message="the replay's result")
+        assert widget.answer_label.text().startswith("Replay done")
+    finally:
+        teach.close()

@@ -41,6 +41,10 @@ class GuiSettings:
     reset_service: str = _derived("`<contact_control_node>/reset`", "Trigger service of Reset")
     guide_service: str = _derived("`<contact_control_node>/guide`", "Guide service of the Guide toggle")
     status_topic: str = _derived("`<contact_control_node>/status`", "status topic of the readout")
+    teach_node: str = param(
+        "teach", nonempty=True,
+        doc="teach's program_server: the Teach box calls its `~record`, `~stop` and `~replay`",
+    )
     retry_period: float = param(1.0, unit="s", gt=0.0, doc="how often the panel looks for the services")
 
 

@@ -33,6 +33,7 @@ class RosNames:
     reset_service: str = f"{_NODE}/reset"
     guide_service: str = f"{_NODE}/guide"
     status_topic: str = f"{_NODE}/status"
+    teach_node: str = GuiSettings.teach_node
     #: compliant_control_msgs/ConfigureLaws, used instead of configure_service when registered (it answers
     #: with the reason of a refusal).
     laws_service: str = "configure_laws"
@@ -51,6 +52,7 @@ class RosNames:
             reset_service=settings.reset_service or f"{node}/reset",
             guide_service=settings.guide_service or f"{node}/guide",
             status_topic=settings.status_topic or f"{node}/status",
+            teach_node=settings.teach_node,
             laws_service=settings.configure_laws_service or f"{namespace}{slash}{cls.laws_service}",
         )
 
@@ -128,6 +130,7 @@ class ContactControlClient:
         self._watcher: threading.Thread | None = None
         self._sub = None
         self._last: Availability | None = None
+        self._replay_client: Any = None
 
     def start(self) -> None:
         """Subscribes to the status and starts watching the services."""
@@ -229,6 +232,60 @@ class ContactControlClient:
             return CallResult(True, bool(response.success), int(response.code), str(response.message))
 
         self._call(self.resolved.guide_service, Guide, GuideRequest(enable=enable), answer, on_done)
+
+    # --- teach (program_server) ---
+    def record(self, name: str, on_done: Callable[[CallResult], None]) -> None:
+        """Starts recording program `name` (teach's ~record) in a worker thread."""
+        from compliant_control_msgs.srv import RecordProgram, RecordProgramRequest
+
+        def answer(response: Any) -> CallResult:
+            return CallResult(True, bool(response.success), None, str(response.message))
+
+        request = RecordProgramRequest(name=name)
+        self._call(self.resolved.teach_node + "/record", RecordProgram, request, answer, on_done)
+
+    def stop_recording(self, on_done: Callable[[CallResult], None]) -> None:
+        """Stops and saves the recording (teach's ~stop)."""
+        from std_srvs.srv import Trigger, TriggerRequest
+
+        def answer(response: Any) -> CallResult:
+            return CallResult(True, bool(response.success), None, str(response.message))
+
+        self._call(self.resolved.teach_node + "/stop", Trigger, TriggerRequest(), answer, on_done)
+
+    def replay(self, name: str, speed: float, press_axis: str, press_force: float,
+               on_done: Callable[[CallResult], None]) -> None:
+        """Sends a replay goal (teach's ~replay action); `on_done` gets its result when it ends."""
+        import actionlib
+        from compliant_control_msgs.msg import ReplayProgramAction, ReplayProgramGoal
+
+        rospy = self._rospy
+
+        def run() -> None:
+            client = self._replay_client
+            if client is None:
+                client = self._replay_client = actionlib.SimpleActionClient(
+                    self.resolved.teach_node + "/replay", ReplayProgramAction)
+            if not client.wait_for_server(rospy.Duration(2.0)):
+                where = self.resolved.teach_node + "/replay"
+                on_done(CallResult(False, message=f"{where} is not available (is program_server running?)"))
+                return
+
+            def done(_state: int, result: Any) -> None:
+                if result is None:
+                    on_done(CallResult(False, message="the replay ended without a result"))
+                else:
+                    on_done(CallResult(True, bool(result.success), None, str(result.message)))
+
+            client.send_goal(ReplayProgramGoal(name=name, speed=speed, press_axis=press_axis,
+                                               press_force=press_force), done_cb=done)
+
+        threading.Thread(target=run, name="mcg-replay", daemon=True).start()
+
+    def cancel_replay(self) -> None:
+        """Cancels the replay this panel started (its result then says where it stopped)."""
+        if self._replay_client is not None:
+            self._replay_client.cancel_all_goals()
 
     def _call(
         self,

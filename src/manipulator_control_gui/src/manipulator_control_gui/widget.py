@@ -38,6 +38,7 @@ from manipulator_control_gui.form import (
 from manipulator_control_gui.form_config import AXES, AXIS_LABELS, FIELDS, LAW_FIELDS, LAWS, GuiConfig
 from manipulator_control_gui.readout import readout_from_status, refusal_in_status
 from manipulator_control_gui.ros_client import Availability, CallResult, ContactControlClient, RosNames
+from manipulator_control_gui.teach_box import TeachBox
 
 __all__ = ["ControlWidget"]
 
@@ -157,6 +158,10 @@ class ControlWidget(QWidget):
             lambda availability: self._bridge.send("availability", availability),
             retry_period,
         )
+        self.teach_box = TeachBox(
+            self.client, lambda which, result: self._bridge.send("answer", which, result), self
+        )
+        self._layout.insertWidget(self._layout.indexOf(self.answer_label), self.teach_box)
         self._status_timer = QTimer(self)
         self._status_timer.timeout.connect(self._check_status_age)
         self._status_timer.start(250)
@@ -164,7 +169,7 @@ class ControlWidget(QWidget):
 
     # ---- construction --------------------------------------------------------------------------------------
     def _build(self) -> None:
-        layout = QVBoxLayout(self)
+        layout = self._layout = QVBoxLayout(self)
         self.connection_label = QLabel("Looking for contact_control…", self)
         self.connection_label.setObjectName("connection_label")
         self.connection_label.setWordWrap(True)
