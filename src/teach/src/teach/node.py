@@ -108,19 +108,18 @@ class TeachNode:
     # --- inputs ---
     def _on_joints(self, msg: JointState) -> None:
         self._joints = msg
-        bag = self._bag
-        if bag is not None:
-            with self._lock:
-                if self._bag is not None:
-                    self._bag.write(self.settings.joint_states_topic, msg)
+        self._keep(self.settings.joint_states_topic, msg)
 
     def _on_wrench(self, msg: WrenchStamped) -> None:
         self._wrench = msg
-        bag = self._bag
-        if bag is not None:
+        self._keep(self.settings.wrench_topic, msg)
+
+    def _keep(self, topic: str, msg: JointState | WrenchStamped) -> None:
+        """Into the raw stream's bag, when one is being kept."""
+        if self._bag is not None:
             with self._lock:
-                if self._bag is not None:
-                    self._bag.write(self.settings.wrench_topic, msg)
+                if self._bag is not None:  # it may have closed meanwhile
+                    self._bag.write(topic, msg)
 
     def _on_sample(self, _event: TimerEvent | None) -> None:
         rec = self.recorder
