@@ -141,3 +141,26 @@ def test_malformed_files_are_refused_naming_the_problem(tmp_path):
     data["format"] = 2
     with pytest.raises(ProgramError, match="format 2"):
         Program.from_dict(data)
+
+
+def test_playback_follows_the_waypoints_in_time_and_its_clock_pauses_and_slows():
+    from teach.playback import Playback, path_distance
+
+    program = recorded()
+    play = Playback(program, speed=2.0)
+    assert play.duration == pytest.approx(program.duration)
+    play.advance(1.0)  # 1 s of replay at 2x: 2 s of the program
+    p, _, twist = play.reference()
+    assert play.time == pytest.approx(2.0) and p[0] > program.waypoints[0].position[0]
+    play.paused = True
+    play.advance(1.0)
+    assert play.time == pytest.approx(2.0) and not np.any(play.reference()[2])  # held, no velocity
+    play.paused = False
+    play.advance(1.0, rate=0.5)  # slowed for the arm: half the clock, half the fed-forward velocity
+    assert play.time == pytest.approx(3.0)
+    assert np.linalg.norm(play.reference()[2][:3]) < np.linalg.norm(twist[:3])
+    play.advance(100.0)
+    assert play.done and play.progress == 1.0 and not np.any(play.reference()[2])
+    path = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.1, 0.05, 0.0]])
+    d = path_distance(np.array([[0.05, 0.002, 0.0], [0.103, 0.02, 0.0], [0.2, 0.0, 0.0]]), path)
+    assert d == pytest.approx([0.002, 0.003, 0.1])

@@ -56,6 +56,23 @@ class TeachSettings:
     replay_max_path_error: float = param(
         0.03, unit="m", gt=0.0, doc="a path axis this far from the reference ends the replay (PATH_ERROR)"
     )
+    replay_lead: float = param(
+        0.03, unit="s", ge=0.0,
+        doc="the fed-forward velocity is the path's this far ahead: the command path's latency (jogger, "
+        "driver, servo), so the tool slows where the path does instead of overshooting (a guess from the "
+        "simulated arms' 20-50 ms)",
+    )
+    replay_lag: float = param(
+        0.0015, unit="m", gt=0.0,
+        doc="while the tool is this far off the reference across the path's direction (cutting a corner), "
+        "the "
+        "program's clock slows, to a tenth at twice it: the path is kept, the timing gives",
+    )
+    replay_lag_along: float = param(
+        0.01, unit="m", gt=0.0,
+        doc="the same for the tool's lag behind the reference (the arm at its velocity or acceleration "
+        "limit)",
+    )
     replay_max_angle_error: float = param(0.2, unit="rad", gt=0.0, doc="same for rotations")
     replay_press_damping: float = param(
         800.0, unit="N/(m/s)", gt=0.0,

@@ -51,6 +51,7 @@ class Playback:
         self._q = np.array([p.orientation for p in w])
         self.time = 0.0  # program time [s] reached
         self.paused = False
+        self.rate = 1.0  # the clock's last rate, times `speed` (< 1: slowed for the arm), scales the twist
 
     @property
     def duration(self) -> float:
@@ -65,21 +66,30 @@ class Playback:
     def done(self) -> bool:
         return self.time >= self.duration
 
-    def advance(self, dt: float) -> None:
-        """`dt` [s] of replay time passed (nothing while paused)."""
+    def advance(self, dt: float, rate: float = 1.0) -> None:
+        """`dt` [s] of replay time passed, the clock running at `rate` (in (0, 1]) times `speed`; nothing
+        while paused."""
+        self.rate = rate
         if not self.paused:
-            self.time = min(self.duration, self.time + dt * self.speed)
+            self.time = min(self.duration, self.time + dt * self.speed * rate)
 
-    def reference(self) -> tuple[FloatArray, tuple[float, float, float, float], FloatArray]:
-        """(position, quaternion, twist (vx, vy, vz, wx, wy, wz)) at the current time; the twist is zero while
-        paused or at the end."""
+    def reference(
+        self, lead: float = 0.0
+    ) -> tuple[FloatArray, tuple[float, float, float, float], FloatArray]:
+        """(position, quaternion, twist (vx, vy, vz, wx, wy, wz)) at the current time; the twist is the one
+        `lead` [s] of replay time ahead (the command path's latency: the arm slows where the path does, not
+        that late), zero while paused or at the end."""
         p, q, i = interpolate(self._t, self._p, self._q, self.time)
         twist = np.zeros(6)
-        if not self.paused and not self.done:
+        ahead = min(self.time + lead * self.speed * self.rate, self.duration)
+        if lead > 0.0:
+            i = interpolate(self._t, self._p, self._q, ahead)[2]
+        if not self.paused and not self.done and ahead < self.duration:
             span = self._t[i + 1] - self._t[i]
             if span > 0.0:
-                twist[:3] = (self._p[i + 1] - self._p[i]) / span * self.speed
-                twist[3:] = _rotvec(self._q[i], self._q[i + 1]) / span * self.speed
+                scale = self.speed * self.rate
+                twist[:3] = (self._p[i + 1] - self._p[i]) / span * scale
+                twist[3:] = _rotvec(self._q[i], self._q[i + 1]) / span * scale
         return p, q, twist
 
 

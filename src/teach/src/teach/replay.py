@@ -38,6 +38,11 @@ from teach.program import Program, ProgramError, ProgramStore
 
 __all__ = ["ReplayServer"]
 
+
+def _slowed(error: float, limit: float) -> float:
+    """1 up to `limit`, then falling linearly to 0.1 at twice it."""
+    return 1.0 if error <= limit else max(0.1, 1.0 - 0.9 * (error - limit) / limit)
+
 AXES = ("x", "y", "z", "rx", "ry", "rz")
 PRESS_AXES = ("x", "y", "z")
 FEEDBACK_EVERY = 10  # reference cycles per feedback message (10 Hz at 100 Hz)
@@ -195,7 +200,7 @@ class ReplayServer:
         return np.array([p.x, p.y, p.z])
 
     def _send(self, play: Playback) -> None:
-        p, q, v = play.reference()
+        p, q, v = play.reference(self.s.replay_lead)
         ref = self._ref
         ref.header.stamp = rospy.Time.now()
         pos, ori = ref.pose.position, ref.pose.orientation
@@ -238,6 +243,8 @@ class ReplayServer:
         state = "pressing" if press >= 0 else "replaying"
         last, cycle, settle_until = rospy.get_time(), 0, None
         steady_since: float | None = None
+        tool: np.ndarray | None = None
+        replay_started = rospy.get_time()
         active_seen = False
         target = goal.press_force
         ours = True  # the move is still ours to stop (contact_control did not end it)
@@ -268,11 +275,12 @@ class ReplayServer:
                         steady_since = now
                     if steady_since is not None and now - steady_since >= s.press_settle_time:
                         state, last = "replaying", rospy.get_time()
+                        replay_started = last
                     elif now - move_started > s.press_timeout:
                         return self._ended(False, f"no steady contact force along {goal.press_axis} within "
                                                   f"{s.press_timeout:g} s", distances, forces)
                 else:
-                    play.advance(dt)
+                    play.advance(dt, self._keep_up(play, tool, keep))
                     if press >= 0:
                         forces.append(force)
                 tool = self._tool()
@@ -290,6 +298,10 @@ class ReplayServer:
                     settle_until = settle_until or now + s.settle_time
                     if now >= settle_until:
                         done = f"program '{program.name}' replayed at {speed:g} x its speed"
+                        took, planned = now - replay_started, play.duration / speed
+                        if took - s.settle_time > 1.1 * planned + 0.2:
+                            done += (f", slowed where the arm could not keep up ({took:.1f} s instead of "
+                                     f"{planned:.1f} s)")
                         return self._ended(True, done,
                                            distances, forces)
                 rate.sleep()
@@ -297,6 +309,22 @@ class ReplayServer:
         finally:
             if ours:
                 self._stop_move()
+
+    def _keep_up(self, play: Playback, tool: np.ndarray | None, keep: list[int]) -> float:
+        """How fast the program's clock runs now (1: the requested speed). It slows while the tool is more
+        than `replay_lag` off the reference across the path's direction (a corner being cut) or more than
+        `replay_lag_along` behind it (the arm at its limits), down to a tenth at twice either, so the
+        reference waits for the arm instead of running away from it."""
+        if tool is None:
+            return 1.0
+        reference, _, twist = play.reference()
+        error = reference[keep] - tool[keep]
+        velocity = twist[:3][keep]
+        speed = float(np.linalg.norm(velocity))
+        across = error if speed < 1e-6 else error - (error @ velocity) / speed**2 * velocity
+        s = self.s
+        return min(_slowed(float(np.linalg.norm(across)), s.replay_lag),
+                   _slowed(float(np.linalg.norm(error)), s.replay_lag_along))
 
     def _stop_move(self) -> None:
         try:

@@ -1,0 +1,81 @@
+"""Teach by hand, end to end on the simulated UR5: with hand-guiding on, the simulated human pushes the tool
+along an L (about 10 cm along +X, then 5 cm along +Y) while program_server records it; the program replays in
+free space within 2 mm RMS / 5 mm max of the recorded path."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+pytest.importorskip("compliant_control_msgs.msg", reason="needs devel/setup.bash (make test sources it)")
+
+import actionlib
+from compliant_control_msgs.msg import ContactControlStatus, ReplayProgramAction, ReplayProgramGoal
+from compliant_control_msgs.srv import Guide, PushEEF, PushEEFRequest, RecordProgram
+from geometry_msgs.msg import PoseStamped
+from harness.launch import run_launch
+from harness.waiting import Collector, wait_until
+from sensor_msgs.msg import JointState
+from std_srvs.srv import Trigger
+from teach.program import ProgramStore
+
+PUSH = 6.0  # [N]: 6 / 50 (guide_damping_linear) = 12 cm/s while it lasts
+
+
+def test_a_hand_guided_l_is_recorded_and_replayed_within_2_mm(ros_node, tmp_path):
+    rospy = ros_node
+    home = tmp_path / "home"
+    with run_launch("ur5_custom", "sim.launch", env={**os.environ, "HOME": str(home)}) as h:
+        for service in ("/teach/record", "/contact_control_node/guide", "/mujoco_driver/push",
+                        "/named_poses/move_to_joints"):
+            h.wait_for_service(service, timeout=40)
+        status = Collector("/contact_control_node/status", ContactControlStatus)
+        joints = Collector("/joint_states", JointState)
+        pose = Collector("/mujoco_driver/eef_pose", PoseStamped)
+        push_eef = rospy.ServiceProxy("/mujoco_driver/push", PushEEF)
+        try:
+            for c in (status, joints, pose):
+                c.wait_for(1, timeout=20)
+            ok = ContactControlStatus.SAFETY_OK
+            wait_until(lambda: status.last().safety == ok, 20, "the zeroed sensor")
+
+            def at_rest() -> bool:
+                return np.max(np.abs(joints.last().velocity)) < 2e-3
+
+            def push(x: float, y: float, seconds: float) -> None:
+                request = PushEEFRequest(duration=seconds)
+                request.wrench.force.x, request.wrench.force.y = x, y
+                assert push_eef(request).success
+                wait_until(lambda: not at_rest(), 5, "the guided tool to move")
+                wait_until(at_rest, 15, "the tool to come to rest after the push")
+
+            assert rospy.ServiceProxy("/contact_control_node/guide", Guide)(enable=True, axes=[]).success
+            assert rospy.ServiceProxy("/teach/record", RecordProgram)(name="l_by_hand").success
+            push(PUSH, 0.0, 1.0)  # along +X
+            push(0.0, PUSH, 0.5)  # then +Y
+            saved = rospy.ServiceProxy("/teach/stop", Trigger)()
+            assert saved.success, saved.message
+            assert rospy.ServiceProxy("/contact_control_node/guide", Guide)(enable=False, axes=[]).success
+            program = ProgramStore(str(home / ".ros" / "compliant_programs")).load("l_by_hand")
+            legs = np.array(program.waypoints[-1].position) - np.array(program.waypoints[0].position)
+            print(f"\n{program.summary()}; legs {legs[0] * 1e3:.1f} mm X, {legs[1] * 1e3:.1f} mm Y")
+            assert legs[0] > 0.07 and legs[1] > 0.035 and abs(legs[2]) < 0.003, legs
+
+            client = actionlib.SimpleActionClient("/teach/replay", ReplayProgramAction)
+            assert client.wait_for_server(rospy.Duration(20.0))
+            # At its speed only: twice this fast hand (0.24 m/s, four times its accelerations) is beyond the
+            # arm's limits, and the slowed replay still cut 12-13 mm (teach's README; issue #22's note). Twice
+            # the speed is checked on the 2 cm/s L of test_teach_replay.py.
+            for speed in (1.0,):
+                client.send_goal(ReplayProgramGoal(name="l_by_hand", speed=speed))
+                assert client.wait_for_result(rospy.Duration(90.0))
+                result = client.get_result()
+                print(f"replay by hand at {speed:g}x: {result.message}")
+                assert result.success, result.message
+                assert result.path_error_rms < 0.002 and result.path_error_max < 0.005, result.message
+        finally:
+            for c in (status, joints, pose):
+                c.close()
+        h.stop()
