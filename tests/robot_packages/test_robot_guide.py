@@ -5,17 +5,18 @@ The UR5 runs the default single process (control_stack), the Panda the two-node 
 
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
 import pytest
 
 pytest.importorskip("compliant_control_msgs.srv", reason="needs devel/setup.bash (make test sources it)")
 
-from compliant_control_msgs.msg import AxisLaw, ContactControlStatus, ContactEvent
+from compliant_control_msgs.msg import AxisLaw, ContactEvent
 from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsRequest, Guide, PushEEF, PushEEFRequest
-from geometry_msgs.msg import PoseStamped
 from harness.launch import run_launch
+from harness.observed import SimArm
 from harness.waiting import Collector, wait_until
-from sensor_msgs.msg import JointState
 
 PUSH = 6.0  # [N] along +X of the base: 6 / 50 (guide_damping_linear) = 0.12 m/s while it lasts
 
@@ -28,23 +29,10 @@ def test_guide_gives_way_to_a_push_rests_after_it_and_events_tell_what_happened(
         h.wait_for_topic("/mujoco_driver/eef_pose", timeout=40)
         for service in ("/contact_control_node/guide", "/mujoco_driver/push", "/configure_laws"):
             h.wait_for_service(service, timeout=40)
-        pose = Collector("/mujoco_driver/eef_pose", PoseStamped)
-        joints = Collector("/joint_states", JointState)
-        status = Collector("/contact_control_node/status", ContactControlStatus)
-        events = Collector("/contact_control_node/events", ContactEvent)
         guide = rospy.ServiceProxy("/contact_control_node/guide", Guide)
-        try:
-            for c in (pose, joints, status):
-                c.wait_for(1, timeout=20)
-            zeroed = ContactControlStatus.SAFETY_OK
-            wait_until(lambda: status.last().safety == zeroed, 20, "the sensor to be zeroed")
-
-            def tip() -> np.ndarray:
-                p = pose.last().pose.position
-                return np.array([p.x, p.y, p.z])
-
-            def at_rest() -> bool:
-                return np.max(np.abs(joints.last().velocity)) < 2e-3
+        events_topic = Collector("/contact_control_node/events", ContactEvent)
+        with SimArm() as arm, contextlib.closing(events_topic) as events:
+            pose, status, tip, at_rest = arm.pose, arm.status, arm.tip, arm.at_rest
 
             answer = guide(enable=True, axes=[])
             assert answer.success, answer.message
@@ -98,7 +86,4 @@ def test_guide_gives_way_to_a_push_rests_after_it_and_events_tell_what_happened(
             limit = events.msgs[1]
             assert abs(limit.wrench.force.z) >= 8.0 and "limit" in limit.message, limit
             assert limit.pose.pose.position.z < start[2] - 0.05  # down on the block, 7 cm below the start
-        finally:
-            for c in (pose, joints, status, events):
-                c.close()
         h.stop()

@@ -12,12 +12,11 @@ import pytest
 pytest.importorskip("compliant_control_msgs.msg", reason="needs devel/setup.bash (make test sources it)")
 
 import actionlib
-from compliant_control_msgs.msg import ContactControlStatus, ReplayProgramAction, ReplayProgramGoal
+from compliant_control_msgs.msg import ReplayProgramAction, ReplayProgramGoal
 from compliant_control_msgs.srv import Guide, PushEEF, PushEEFRequest, RecordProgram
-from geometry_msgs.msg import PoseStamped
 from harness.launch import run_launch
-from harness.waiting import Collector, wait_until
-from sensor_msgs.msg import JointState
+from harness.observed import SimArm
+from harness.waiting import wait_until
 from std_srvs.srv import Trigger
 from teach.program import ProgramStore
 
@@ -31,25 +30,15 @@ def test_a_hand_guided_l_is_recorded_and_replayed_within_2_mm(ros_node, tmp_path
         for service in ("/teach/record", "/contact_control_node/guide", "/mujoco_driver/push",
                         "/named_poses/move_to_joints"):
             h.wait_for_service(service, timeout=40)
-        status = Collector("/contact_control_node/status", ContactControlStatus)
-        joints = Collector("/joint_states", JointState)
-        pose = Collector("/mujoco_driver/eef_pose", PoseStamped)
         push_eef = rospy.ServiceProxy("/mujoco_driver/push", PushEEF)
-        try:
-            for c in (status, joints, pose):
-                c.wait_for(1, timeout=20)
-            ok = ContactControlStatus.SAFETY_OK
-            wait_until(lambda: status.last().safety == ok, 20, "the zeroed sensor")
-
-            def at_rest() -> bool:
-                return np.max(np.abs(joints.last().velocity)) < 2e-3
+        with SimArm() as arm:
 
             def push(x: float, y: float, seconds: float) -> None:
                 request = PushEEFRequest(duration=seconds)
                 request.wrench.force.x, request.wrench.force.y = x, y
                 assert push_eef(request).success
-                wait_until(lambda: not at_rest(), 5, "the guided tool to move")
-                wait_until(at_rest, 15, "the tool to come to rest after the push")
+                wait_until(lambda: not arm.at_rest(), 5, "the guided tool to move")
+                wait_until(arm.at_rest, 15, "the tool to come to rest after the push")
 
             assert rospy.ServiceProxy("/contact_control_node/guide", Guide)(enable=True, axes=[]).success
             assert rospy.ServiceProxy("/teach/record", RecordProgram)(name="l_by_hand").success
@@ -75,7 +64,4 @@ def test_a_hand_guided_l_is_recorded_and_replayed_within_2_mm(ros_node, tmp_path
                 print(f"replay by hand at {speed:g}x: {result.message}")
                 assert result.success, result.message
                 assert result.path_error_rms < 0.002 and result.path_error_max < 0.005, result.message
-        finally:
-            for c in (status, joints, pose):
-                c.close()
         h.stop()

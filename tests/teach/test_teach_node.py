@@ -7,12 +7,10 @@ from __future__ import annotations
 import os
 import subprocess
 
-import numpy as np
 import pytest
 
 pytest.importorskip("compliant_control_msgs.srv", reason="needs devel/setup.bash (make test sources it)")
 
-from compliant_control_msgs.msg import ContactControlStatus
 from compliant_control_msgs.srv import (
     Guide,
     ListPrograms,
@@ -21,10 +19,9 @@ from compliant_control_msgs.srv import (
     PushEEFRequest,
     RecordProgram,
 )
-from geometry_msgs.msg import PoseStamped
 from harness.launch import run_launch
-from harness.waiting import Collector, wait_until
-from sensor_msgs.msg import JointState
+from harness.observed import SimArm
+from harness.waiting import wait_until
 from std_srvs.srv import Trigger
 from teach.program import ProgramStore
 
@@ -37,17 +34,11 @@ def test_record_a_hand_guided_push_save_list_show_and_delete(ros_node, tmp_path)
     with run_launch("ur5_custom", "sim.launch", env=env) as h:
         for service in ("/teach/record", "/teach/stop", "/contact_control_node/guide", "/mujoco_driver/push"):
             h.wait_for_service(service, timeout=40)
-        status = Collector("/contact_control_node/status", ContactControlStatus)
-        joints = Collector("/joint_states", JointState)
-        pose = Collector("/mujoco_driver/eef_pose", PoseStamped)
         record = rospy.ServiceProxy("/teach/record", RecordProgram)
         stop = rospy.ServiceProxy("/teach/stop", Trigger)
         keyframe = rospy.ServiceProxy("/teach/keyframe", Trigger)
-        try:
-            for c in (status, joints, pose):
-                c.wait_for(1, timeout=20)
-            ok = ContactControlStatus.SAFETY_OK
-            wait_until(lambda: status.last().safety == ok, 20, "the zeroed sensor")
+        with SimArm() as arm:
+            pose, joints = arm.pose, arm.joints
             # Refusals first: nothing to stop, a bad name.
             assert not stop().success
             answer = record(name="../x", keep_bag=False, overwrite=False)
@@ -66,7 +57,7 @@ def test_record_a_hand_guided_push_save_list_show_and_delete(ros_node, tmp_path)
             wait_until(lambda: pose.last().pose.position.x - start_x > 0.01, 10, "the guided tool to move")
             assert keyframe().success
             wait_until(lambda: pose.last().pose.position.x - start_x > 0.03, 10, "the tool to go on")
-            wait_until(lambda: np.max(np.abs(joints.last().velocity)) < 2e-3, 10, "the arm at rest")
+            wait_until(arm.at_rest, 10, "the arm at rest")
             end_x = pose.last().pose.position.x
             saved = stop()
             assert saved.success and "push_x: robot" in saved.message, saved.message
@@ -103,7 +94,4 @@ def test_record_a_hand_guided_push_save_list_show_and_delete(ros_node, tmp_path)
             out = subprocess.run(["rosrun", "teach", "teach", "delete", "push_x"], capture_output=True,
                                  text=True, timeout=60)
             assert out.returncode == 1 and "no program 'push_x'" in out.stderr
-        finally:
-            for c in (status, joints, pose):
-                c.close()
         h.stop()

@@ -251,7 +251,8 @@ class ReplayServer:
         try:
             while not rospy.is_shutdown():
                 now = rospy.get_time()
-                dt, last = now - last, now
+                # A clock jump (or a stall) moves the program's clock by one cycle at most, never backwards.
+                dt, last = min(max(now - last, 0.0), 2.0 / s.replay_rate), now
                 if self._server.is_preempt_requested():
                     return self._ended(False, f"cancelled at {play.progress:.0%}", distances, forces)
                 status = self._status
