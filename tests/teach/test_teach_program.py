@@ -164,3 +164,39 @@ def test_playback_follows_the_waypoints_in_time_and_its_clock_pauses_and_slows()
     path = np.array([[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.1, 0.05, 0.0]])
     d = path_distance(np.array([[0.05, 0.002, 0.0], [0.103, 0.02, 0.0], [0.2, 0.0, 0.0]]), path)
     assert d == pytest.approx([0.002, 0.003, 0.1])
+
+
+def test_a_replay_faster_than_the_arm_is_slowed_to_its_limits_before_it_starts():
+    from teach.playback import Playback
+    from teach.timing import Limits, replay_times
+
+    program = recorded()  # the L: up to ~15 mm/s along X, ~23 degrees/s about Z at 1x
+    limits = Limits(velocity=0.03, acceleration=0.05, deceleration=0.1, angular_velocity=0.5,
+                    angular_acceleration=5.0, angular_deceleration=5.0)
+    free = Playback(program, speed=4.0)
+    assert free.planned == pytest.approx(program.duration / 4.0)
+    play = Playback(program, speed=4.0, limits=limits)
+    assert program.duration / 4.0 < play.planned < program.duration
+    deltas = play._deltas
+    for timing, within in ((replay_times(free._t, deltas, 4.0, Limits()), False), (play._r, True)):
+        v = deltas / np.diff(timing)[:, None]
+        rest = np.zeros((1, 6))
+        change = np.diff(np.vstack([rest, v, rest]), axis=0)[:, :3]  # at each waypoint
+        half = np.diff(timing) / 2
+        over = np.concatenate(([half[0]], half[:-1] + half[1:], [half[-1]]))
+        speeding = np.abs(np.vstack([v, rest])[:, :3]) > np.abs(np.vstack([rest, v])[:, :3])
+        acc = np.abs(change) / over[:, None]
+        ok = np.all(np.abs(v[:, :3]) <= 0.03 + 1e-9) and np.all(acc[speeding] <= 0.05 * 1.001) and np.all(
+            acc[~speeding] <= 0.1 * 1.001)
+        assert ok == within  # 4x asks more than the arm gives; the plan does not
+    # The same path, its timing stretched: at the same program time, the same pose.
+    play.clock = play.planned * 0.37
+    at_once = Playback(program, 1.0)
+    at_once.clock = play.time
+    assert np.allclose(at_once.reference()[0], play.reference()[0])
+    # The fed-forward twist stays within the velocity limit all along.
+    while not play.done:
+        assert np.abs(play.reference()[2][:3]).max() <= 0.03 + 1e-9
+        play.advance(0.01)
+    slow = Playback(program, speed=0.5, limits=limits)  # within every limit: as asked
+    assert slow.planned == pytest.approx(program.duration / 0.5)

@@ -56,6 +56,12 @@ class TeachSettings:
     replay_max_path_error: float = param(
         0.03, unit="m", gt=0.0, doc="a path axis this far from the reference ends the replay (PATH_ERROR)"
     )
+    replay_limit_fraction: float = param(
+        1.0, gt=0.0, le=1.0,
+        doc="a replay's timing is planned within this fraction of contact_control's velocity, acceleration "
+        "and deceleration limits: faster segments are slowed before they start (1: a motion taught under "
+        "those limits replays at its speed; 0.8 slowed it by 20 %)",
+    )
     replay_lead: float = param(
         0.03, unit="s", ge=0.0,
         doc="the fed-forward velocity is the path's this far ahead: the command path's latency (jogger, "

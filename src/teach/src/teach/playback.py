@@ -10,6 +10,7 @@ from compliant_common.typedefs import FloatArray
 
 from teach.program import Program
 from teach.simplify import interpolate
+from teach.timing import Limits, replay_times
 
 __all__ = ["Playback", "path_distance"]
 
@@ -38,9 +39,10 @@ class Playback:
     Args:
         program: what to play.
         speed: the recorded speed times this (> 0; 2: twice as fast).
+        limits: the arm's; segments that would ask more are slowed (teach.timing), none when None.
     """
 
-    def __init__(self, program: Program, speed: float = 1.0) -> None:
+    def __init__(self, program: Program, speed: float = 1.0, limits: Limits | None = None) -> None:
         if not speed > 0.0:
             raise ValueError(f"speed must be > 0, got {speed}")
         self.program = program
@@ -49,29 +51,43 @@ class Playback:
         self._t = np.array([p.t for p in w])
         self._p = np.array([p.position for p in w])
         self._q = np.array([p.orientation for p in w])
-        self.time = 0.0  # program time [s] reached
+        deltas = np.array([np.concatenate((self._p[i + 1] - self._p[i], _rotvec(self._q[i], self._q[i + 1])))
+                           for i in range(len(w) - 1)]).reshape(-1, 6)
+        self._deltas = deltas
+        # Replay time [s] at each waypoint: the program's time / speed, stretched where the arm cannot follow.
+        self._r = replay_times(self._t, deltas, speed, limits or Limits())
+        self.clock = 0.0  # replay time [s] reached
         self.paused = False
-        self.rate = 1.0  # the clock's last rate, times `speed` (< 1: slowed for the arm), scales the twist
+        self.rate = 1.0  # the clock's last rate (< 1: slowed for the arm), scales the twist
 
     @property
     def duration(self) -> float:
-        """Program time [s]; replay time is duration / speed."""
+        """Program time [s] (as recorded)."""
         return float(self._t[-1])
 
     @property
+    def planned(self) -> float:
+        """Replay time [s] at the requested speed within the arm's limits (>= duration / speed)."""
+        return float(self._r[-1])
+
+    @property
+    def time(self) -> float:
+        """Program time [s] reached."""
+        return float(np.interp(self.clock, self._r, self._t))
+
+    @property
     def progress(self) -> float:
-        return 1.0 if self.duration <= 0.0 else min(1.0, self.time / self.duration)
+        return 1.0 if self.planned <= 0.0 else min(1.0, self.clock / self.planned)
 
     @property
     def done(self) -> bool:
-        return self.time >= self.duration
+        return self.clock >= self.planned
 
     def advance(self, dt: float, rate: float = 1.0) -> None:
-        """`dt` [s] of replay time passed, the clock running at `rate` (in (0, 1]) times `speed`; nothing
-        while paused."""
+        """`dt` [s] of replay time passed, the clock running at `rate` (in (0, 1]); nothing while paused."""
         self.rate = rate
         if not self.paused:
-            self.time = min(self.duration, self.time + dt * self.speed * rate)
+            self.clock = min(self.planned, self.clock + dt * rate)
 
     def reference(
         self, lead: float = 0.0
@@ -79,17 +95,14 @@ class Playback:
         """(position, quaternion, twist (vx, vy, vz, wx, wy, wz)) at the current time; the twist is the one
         `lead` [s] of replay time ahead (the command path's latency: the arm slows where the path does, not
         that late), zero while paused or at the end."""
-        p, q, i = interpolate(self._t, self._p, self._q, self.time)
+        p, q, _ = interpolate(self._t, self._p, self._q, self.time)
         twist = np.zeros(6)
-        ahead = min(self.time + lead * self.speed * self.rate, self.duration)
-        if lead > 0.0:
-            i = interpolate(self._t, self._p, self._q, ahead)[2]
-        if not self.paused and not self.done and ahead < self.duration:
-            span = self._t[i + 1] - self._t[i]
+        ahead = min(self.clock + lead * self.rate, self.planned)
+        if not self.paused and not self.done and ahead < self.planned:
+            i = int(np.clip(np.searchsorted(self._r, ahead, side="right") - 1, 0, len(self._r) - 2))
+            span = self._r[i + 1] - self._r[i]
             if span > 0.0:
-                scale = self.speed * self.rate
-                twist[:3] = (self._p[i + 1] - self._p[i]) / span * scale
-                twist[3:] = _rotvec(self._q[i], self._q[i + 1]) / span * scale
+                twist[:] = self._deltas[i] / span * self.rate
         return p, q, twist
 
 

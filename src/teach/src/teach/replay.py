@@ -29,12 +29,14 @@ from compliant_control_msgs.msg import (
     ReplayProgramResult,
 )
 from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsRequest, MoveToJoints
+from contact_control.params import ContactControlSettings
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 
 from teach.params import TeachSettings
 from teach.playback import Playback, path_distance
 from teach.program import Program, ProgramError, ProgramStore
+from teach.timing import Limits
 
 __all__ = ["ReplayServer"]
 
@@ -225,7 +227,7 @@ class ReplayServer:
             raise ReplayError(f"could not move to the start: {err}") from None
         if not moved.success:
             raise ReplayError(f"could not move to the start: {moved.message}")
-        play = Playback(program, speed)
+        play = Playback(program, speed, self._limits())
         with self._lock:
             self._playback = play
         rate = rospy.Rate(s.replay_rate)
@@ -299,10 +301,12 @@ class ReplayServer:
                     settle_until = settle_until or now + s.settle_time
                     if now >= settle_until:
                         done = f"program '{program.name}' replayed at {speed:g} x its speed"
-                        took, planned = now - replay_started, play.duration / speed
-                        if took - s.settle_time > 1.1 * planned + 0.2:
-                            done += (f", slowed where the arm could not keep up ({took:.1f} s instead of "
-                                     f"{planned:.1f} s)")
+                        took, asked = now - replay_started - s.settle_time, play.duration / speed
+                        if play.planned > 1.05 * asked:
+                            done += (f", slowed to the arm's limits where it was faster "
+                                     f"({play.planned:.1f} s planned instead of {asked:.1f} s)")
+                        if took > 1.1 * play.planned + 0.2:
+                            done += f", and where the arm could not keep up ({took:.1f} s)"
                         return self._ended(True, done,
                                            distances, forces)
                 rate.sleep()
@@ -310,6 +314,26 @@ class ReplayServer:
         finally:
             if ours:
                 self._stop_move()
+
+    def _limits(self) -> Limits:
+        """contact_control's velocity and acceleration limits (its parameters, else its defaults) times
+        `replay_limit_fraction`: what the replay's timing is planned against."""
+        d = ContactControlSettings
+
+        def get(name: str, default: float | None) -> float:
+            value = rospy.get_param(f"{self._cc}/{name}", default)
+            return float(value) if value is not None else math.inf
+
+        linear = get("max_velocity", d.max_velocity)
+        angular = rospy.get_param(f"{self._cc}/max_angular_velocity", d.max_angular_velocity)
+        return Limits(
+            velocity=linear,
+            acceleration=get("acceleration_linear", d.acceleration_linear),
+            deceleration=get("deceleration_linear", d.deceleration_linear),
+            angular_velocity=linear if angular is None else float(angular),
+            angular_acceleration=get("acceleration_angular", d.acceleration_angular),
+            angular_deceleration=get("deceleration_angular", d.deceleration_angular),
+        ).scaled(self.s.replay_limit_fraction)
 
     def _keep_up(self, play: Playback, tool: np.ndarray | None, keep: list[int]) -> float:
         """How fast the program's clock runs now (1: the requested speed). It slows while the tool is more
