@@ -72,6 +72,12 @@ def test_law_moves_toward_the_contact_until_the_force_reaches_the_target():
     up = replace(PRESS, target=-TARGET)
     assert law_velocity(up, TUNING, 0.0, 0.0) == pytest.approx(0.01)
     assert law_velocity(up, TUNING, -13.0, 0.0) == pytest.approx(-3.0 / B)
+    # A small b does not make the approach faster: out of contact it is the approach speed, which sets the
+    # overshoot on touching (10 / 800 = 12.5 mm/s touched a simulated UR3's block with 26 N).
+    soft = replace(PRESS, damping=800.0, velocity=0.005)
+    assert law_velocity(soft, TUNING, 0.0, 0.0) == pytest.approx(-0.005)
+    assert law_velocity(soft, TUNING, 4.0, 0.0) == pytest.approx(-0.005)
+    assert law_velocity(soft, TUNING, 6.0, 0.0) == pytest.approx(-4.0 / 800.0)
 
 
 def test_presses_with_the_target_force_and_holds_it():

@@ -6,6 +6,7 @@ the arm's limits)."""
 from __future__ import annotations
 
 import os
+import re
 
 import numpy as np
 import pytest
@@ -64,5 +65,11 @@ def test_a_hand_guided_l_is_recorded_and_replayed_within_2_mm(ros_node, tmp_path
                 print(f"replay by hand at {speed:g}x: {result.message}")
                 assert result.success, result.message
                 assert result.path_error_rms < 0.002 and result.path_error_max < 0.005, result.message
-                assert (speed > 1.0) == ("slowed to the arm's limits" in result.message), result.message
+                # 2 x of a hand already at the arm's accelerations is slowed; 1 x at most where the hand's
+                # coast stopped faster than the arm is planned to (about 10 %).
+                planned = re.search(r"\(([\d.]+) s planned instead of ([\d.]+) s\)", result.message)
+                if speed > 1.0:
+                    assert planned is not None, result.message
+                elif planned is not None:
+                    assert float(planned[1]) <= 1.25 * float(planned[2]), result.message
         h.stop()

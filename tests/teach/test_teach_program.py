@@ -200,3 +200,43 @@ def test_a_replay_faster_than_the_arm_is_slowed_to_its_limits_before_it_starts()
         play.advance(0.01)
     slow = Playback(program, speed=0.5, limits=limits)  # within every limit: as asked
     assert slow.planned == pytest.approx(program.duration / 0.5)
+
+
+def test_the_fed_forward_velocity_ramps_instead_of_stepping_and_still_covers_the_path():
+    from teach.playback import Playback
+
+    program = recorded()
+    dt = 0.005
+    steps = {}
+    for smoothing in (0.0, 0.1):
+        play = Playback(program, 2.0, smoothing=smoothing)
+        twists = []
+        while not play.done:
+            twists.append(play.reference()[2].copy())
+            play.advance(dt)
+        twists = np.array(twists)
+        steps[smoothing] = np.abs(np.diff(twists[:, :3], axis=0)).max()
+        # Integrated, the velocity goes where the path goes (to within a sample period's worth).
+        moved = twists[:, :3].sum(axis=0) * dt
+        path = np.array(program.waypoints[-1].position) - np.array(program.waypoints[0].position)
+        assert np.allclose(moved, path, atol=0.002), (smoothing, moved, path)
+    assert steps[0.1] < steps[0.0] / 5, steps  # a step at a waypoint becomes a ramp over 0.2 s
+
+
+def test_a_faster_replay_is_never_planned_much_slower_than_a_slower_one():
+    """A hand-taught L (accelerations already at the arm's 0.4 m/s^2): 2 x and 4 x are slowed to the arm,
+    but not below 1 x (stretching each waypoint's two segments fully at once compounded: 2 x planned 2.48 s,
+    1 x 2.18 s)."""
+    import pathlib
+
+    import yaml
+    from teach.playback import Playback
+    from teach.timing import Limits
+
+    data = yaml.safe_load((pathlib.Path(__file__).parent / "data" / "taught_l_jaco2.yaml").read_text())
+    program = Program.from_dict(data)
+    limits = Limits(0.25, 0.4, 0.4, 0.5, 2.5, 2.5)  # a robot package's contact_control limits
+    planned = {s: Playback(program, s, limits).planned for s in (0.5, 1.0, 2.0, 4.0)}
+    assert planned[0.5] == pytest.approx(2 * (program.duration - program.waypoints[0].t))  # within limits
+    assert planned[4.0] <= planned[2.0] * 1.02 and planned[2.0] <= planned[1.0] * 1.02, planned
+    assert planned[2.0] > program.duration / 2  # ... but slowed: 2 x of it is beyond the arm

@@ -149,3 +149,63 @@ def test_surface_following_passes_at_the_target_despite_fast_stick_slip_dips():
 def test_surface_following_fails(force, travel, by_travel, why):
     verdict = judge(by_name(["surface_following"])[0], _surface_recording(force, travel, by_travel))
     assert not verdict.passed, why
+
+
+def _teach_recording(press_force, free=((0.0003, 0.001), (0.0006, 0.0024)), legs=(-0.08, -0.04)):
+    """Taught from 1 to 3 s (X leg, then Y); replays: free 1x, free 2x (path error RMS, max) and pressed
+    from 10 s (its path from 12 to 20 s, `press_force(t)` the contact force on Z)."""
+    from thesis_demos.analysis import Replayed
+
+    def x(t):
+        return legs[0] * min(max(t - 1.0, 0.0), 1.0)
+
+    def y(t):
+        return legs[1] * min(max(t - 2.0, 0.0), 1.0)
+
+    rec = _recording(21.0, x=x, y=y, contact_z=press_force)
+    rec.taught = (1.0, 3.0)
+    (rms1, max1), (rms2, max2) = free
+    rec.replays = [
+        Replayed("free space 1x", 1.0, False, True, "ok", rms1, max1, start=4.0, path_start=5.0, end=7.0),
+        Replayed("free space 2x", 2.0, False, True, "ok", rms2, max2, start=7.0, path_start=8.0, end=9.5),
+        Replayed("pressing", 0.08, True, True, "ok", 0.0001, 0.0002, 10.0, 9.0, 11.0, start=10.0,
+                 path_start=12.0, end=20.0),
+    ]
+    return rec
+
+
+def _teach_scenario():
+    from thesis_demos.scenarios import teach_and_replay
+
+    return teach_and_replay((0.04, 0.02), (-0.08, -0.04))
+
+
+def test_teach_and_replay_passes_with_the_path_kept_and_the_force_held():
+    verdict = judge(_teach_scenario(), _teach_recording(lambda t: 10.3 if round(t * RATE) % 2 else 9.7))
+    assert verdict.passed, verdict.summary
+    assert verdict.figures["taught X leg [mm]"] == pytest.approx(-80.0, abs=0.5)
+    assert verdict.figures["free space 2x: path error max [mm]"] == pytest.approx(2.4)
+    assert verdict.figures["pressing: mean contact force [N]"] == pytest.approx(10.0, abs=0.05)
+
+
+@pytest.mark.parametrize(
+    "force, free, legs, why",
+    [
+        (lambda t: 10.0, ((0.0003, 0.001), (0.0025, 0.006)), (-0.08, -0.04), "2x off the path"),
+        (lambda t: 10.0 + 2.0 * (t > 15.0), ((0.0003, 0.001), (0.0006, 0.0024)), (-0.08, -0.04),
+         "the force left the band"),
+        (lambda t: 10.0, ((0.0003, 0.001), (0.0006, 0.0024)), (-0.03, -0.04), "a short X leg"),
+    ],
+)
+def test_teach_and_replay_fails(force, free, legs, why):
+    verdict = judge(_teach_scenario(), _teach_recording(force, free, legs))
+    assert not verdict.passed, why
+
+
+def test_teach_and_replay_fails_when_a_replay_failed_or_did_not_run():
+    rec = _teach_recording(lambda t: 10.0)
+    rec.replays[2].success, rec.replays[2].message = False, "stopped at 21%: force limit"
+    assert "stopped at 21%" in judge(_teach_scenario(), rec).summary
+    rec.replays = rec.replays[:2]
+    verdict = judge(_teach_scenario(), rec)
+    assert not verdict.passed and "1 of the 3 replays did not run" in verdict.summary

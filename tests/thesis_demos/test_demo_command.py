@@ -45,3 +45,22 @@ def test_driver_options_without_a_driver_are_refused_before_anything_launches(tm
     assert run.returncode == 2
     assert "--driver-options needs --driver" in run.stderr
     assert not (tmp_path / "launch.log").exists()
+
+
+def test_teach_and_replay_on_a_generated_arm(tmp_path):
+    """The sixth demonstration as `make demo ROBOT=ur3` runs it: the L taught by the simulated hand is
+    replayed in free space within 2 mm RMS / 5 mm max at 1 x and 2 x, and pressing on the block within
+    10 +- 1.5 N; the program lands in HOME's ~/.ros/compliant_programs."""
+    import os
+
+    home = tmp_path / "home"
+    command = _demo("--robot", "ur3", "--only", "teach_and_replay", "--output", str(tmp_path / "out"))
+    run = subprocess.run(command, capture_output=True, text=True, timeout=300, check=False,
+                         env={**os.environ, "HOME": str(home)})
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    assert "[PASS] teach_and_replay: taught -" in run.stdout
+    for label in ("free space 1x", "free space 2x", "pressing 10 N at 0.08"):
+        assert f"  {label}" in run.stdout
+    assert (home / ".ros" / "compliant_programs" / "thesis_demos_teach_and_replay.yaml").exists()
+    report = (tmp_path / "out" / "report.md").read_text()
+    assert "teach_and_replay.png" in report and "free space 2x: path error max [mm]" in report

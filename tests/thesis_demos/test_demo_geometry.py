@@ -91,7 +91,7 @@ def test_preflight_names_a_hybrid_path_through_the_obstacle():
 
 def test_preflight_without_obstacle_refuses_only_the_demos_that_press_on_it():
     problems = preflight(DemoGeometry(), (0.6, 0.1, 0.20), None)
-    assert sorted(problems) == ["compliant_move_z", "surface_following"]
+    assert sorted(problems) == ["compliant_move_z", "surface_following", "teach_and_replay"]
 
 
 def test_surface_following_needs_a_block_the_tool_stays_on_over_its_slide():
@@ -154,3 +154,29 @@ def test_the_contact_force_limit_is_per_driver_and_a_sensor_that_cannot_resolve_
     assert "reaches contact_control's 25 N global limit" in unresolvable(spring, floor(1.05, raw=4.0), 5.0)
     assert unresolvable(spring, floor(1.05, raw=4.0), 5.0, global_force=40.0) == ""
     assert unresolvable(spring, floor(0.24, raw=0.63), 5.0) == ""
+
+
+def test_the_taught_l_is_scaled_onto_the_block_and_a_block_too_small_is_named():
+    from thesis_demos.geometry import RobotSetup, fit_l
+
+    # The 15 cm block with a 6 cm wide tool: 15 - 2 x (3 + 0.5) = 8 cm for the 10 cm leg: an 8 x 4 cm L,
+    # centred on the block, X toward the base (-X), Y toward y = 0 (here from y = 0.1: -Y).
+    corner, legs = fit_l((0.6, 0.1, 0.20), BOX, 0.03)
+    assert legs == pytest.approx((-0.08, -0.04)) and corner == pytest.approx((0.04, 0.02))
+    start = (0.6 + corner[0], 0.1 + corner[1])
+    for x, y in (start, (start[0] + legs[0], start[1]), (start[0] + legs[0], start[1] + legs[1])):
+        assert BOX.covers(x, y, inset=0.03)  # every corner of the L keeps the whole tool on the block
+    # A large block: the full 10 x 5 cm L, +Y from y = 0.
+    big = Obstacle((0.5, 0.0, 0.05), (0.4, 0.4, 0.1))
+    assert fit_l((0.5, 0.0, 0.2), big, 0.03) == ((pytest.approx(0.05), pytest.approx(-0.025)),
+                                                  (pytest.approx(-0.10), pytest.approx(0.05)))
+    small = Obstacle((0.6, 0.1, 0.065), (0.09, 0.09, 0.13))
+    reason = preflight(DemoGeometry(), (0.6, 0.1, 0.20), small, 0.03)["teach_and_replay"]
+    assert "leaves 2.0 cm for the L's 10 cm leg" in reason and "a larger block" in reason
+    assert "not under the tool tip" in fit_l((0.3, 0.1, 0.2), BOX, 0.03)
+    # run_demos' scenarios get the arm's L; without a scene, the thesis-sized one stays.
+    scenarios = by_name(["teach_and_replay", "spring_x"])
+    fitted = RobotSetup(DemoGeometry(), BOX, 0.03, checks_scene=True).fitted(scenarios, (0.6, 0.1, 0.2))
+    assert fitted[0].teach.legs == pytest.approx((-0.08, -0.04)) and "8 x 4 cm" in fitted[0].title
+    assert fitted[1] is scenarios[1]
+    assert RobotSetup(DemoGeometry()).fitted(scenarios, (0.6, 0.1, 0.2)) == scenarios

@@ -14,8 +14,8 @@ the law was set [m] ([rad]), V the commanded velocity [m/s] ([rad/s]):
   No deadband around zero force (free air must move the tool toward the contact), but V = 0 while
   |F - F_target| <= `track_deadband`, and no minimum velocity (a stiff surface needs a large b, so small
   corrections are slow ones). Out of contact (F short of `contact_fraction` of the target, on the target's
-  side) the axis approaches at least at the law's approach speed (`velocity`) toward the contact, since
-  (F - F_target) / b with a b fit for a stiff surface would creep for a long time through free air.
+  side) the axis approaches at the law's approach speed (`velocity`) toward the contact: (F - F_target) / b
+  with a b fit for a stiff surface would creep through free air, with a small b it would hit the surface.
 - path: V = v_ref + k e (+ F / b when b > 0, outside the follower's deadband), e the pose error to a reference
   that moves (a replay streams it, `path_ref.PathReference`): a spring whose anchor travels along the path,
   with the path's velocity fed forward. `max_travel` bounds |e| (PATH_ERROR).
@@ -116,11 +116,12 @@ def law_velocity(law: AxisLaw, tuning: AxisTuning, force: float, travel: float) 
             return 0.0
         v = error / law.damping
         target = law.target
-        # Out of contact: the force has not come up to contact_fraction of the target on the target's side.
+        # Out of contact (the force short of contact_fraction of the target on the target's side): toward
+        # it at the approach speed, which sets the overshoot on touching; never faster for a small b.
         if target > 0.0 and force < tuning.contact_fraction * target:
-            return min(v, -law.velocity)
+            return -law.velocity
         if target < 0.0 and force > tuning.contact_fraction * target:
-            return max(v, law.velocity)
+            return law.velocity
         return v
     return 0.0
 

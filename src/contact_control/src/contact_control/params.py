@@ -251,7 +251,7 @@ class ContactControlSettings:
     force_tracking_deadband_torque: float = _nonneg(0.02, "Nm", "same for torques")
     force_tracking_contact_fraction: float = param(
         0.5, gt=0.0, le=1.0, unit="fraction of the target",
-        doc="force tracking is out of contact, and approaches at least at its approach speed, while F is "
+        doc="force tracking is out of contact, and approaches at its approach speed, while F is "
         "short of this fraction of the target",
     )
     # path law (ConfigureLaws PATH, fed by ~path_reference)

@@ -62,6 +62,12 @@ class TeachSettings:
         "and deceleration limits: faster segments are slowed before they start (1: a motion taught under "
         "those limits replays at its speed; 0.8 slowed it by 20 %)",
     )
+    replay_smoothing: float = param(
+        0.1, unit="s", ge=0.0,
+        doc="the fed-forward velocity is the path's mean over this much replay time either side, so it ramps "
+        "instead of stepping at a waypoint (a step jerks the tool: pressing on the simulated block, each "
+        "waypoint's step swung the force by 3-4 N)",
+    )
     replay_lead: float = param(
         0.03, unit="s", ge=0.0,
         doc="the fed-forward velocity is the path's this far ahead: the command path's latency (jogger, "
@@ -82,9 +88,9 @@ class TeachSettings:
     replay_max_angle_error: float = param(0.2, unit="rad", gt=0.0, doc="same for rotations")
     replay_press_damping: float = param(
         800.0, unit="N/(m/s)", gt=0.0,
-        doc="force tracking b on the press axis: an L on the simulated block at 1 cm/s stayed within "
-        "8.92-10.87 N at 800, 8.46-11.60 N at 2000 (friction turning at the corner); 500 rings "
-        "(contact_control's README, Force tracking)",
+        doc="force tracking b on the press axis: the sixth demonstration's L on the simulated block held "
+        "9.16-10.76 N (UR5) and 8.79-10.92 N (UR3) at 800, 9.43-11.44 and 8.93-11.26 at 2000 (friction "
+        "turning at the corner); 500 rings (contact_control's README, Force tracking)",
     )
     replay_press_approach: float = param(
         0.005, unit="m/s", gt=0.0,

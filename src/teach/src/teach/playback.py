@@ -40,9 +40,12 @@ class Playback:
         program: what to play.
         speed: the recorded speed times this (> 0; 2: twice as fast).
         limits: the arm's; segments that would ask more are slowed (teach.timing), none when None.
+        smoothing: the fed-forward twist is the mean over this much replay time either side [s] (0: each
+            segment's own, stepping at the waypoints).
     """
 
-    def __init__(self, program: Program, speed: float = 1.0, limits: Limits | None = None) -> None:
+    def __init__(self, program: Program, speed: float = 1.0, limits: Limits | None = None,
+                 smoothing: float = 0.0) -> None:
         if not speed > 0.0:
             raise ValueError(f"speed must be > 0, got {speed}")
         self.program = program
@@ -54,6 +57,10 @@ class Playback:
         deltas = np.array([np.concatenate((self._p[i + 1] - self._p[i], _rotvec(self._q[i], self._q[i + 1])))
                            for i in range(len(w) - 1)]).reshape(-1, 6)
         self._deltas = deltas
+        # The motion so far at each waypoint (position, summed rotation vectors): the fed-forward twist is its
+        # central difference over 2 * smoothing, so the velocity ramps instead of stepping at a waypoint.
+        self._so_far = np.vstack([np.zeros(6), np.cumsum(deltas, axis=0)])
+        self.smoothing = smoothing  # [s] half the window (0: each segment's velocity, stepping at waypoints)
         # Replay time [s] at each waypoint: the program's time / speed, stretched where the arm cannot follow.
         self._r = replay_times(self._t, deltas, speed, limits or Limits())
         self.clock = 0.0  # replay time [s] reached
@@ -98,11 +105,20 @@ class Playback:
         p, q, _ = interpolate(self._t, self._p, self._q, self.time)
         twist = np.zeros(6)
         ahead = min(self.clock + lead * self.rate, self.planned)
-        if not self.paused and not self.done and ahead < self.planned:
-            i = int(np.clip(np.searchsorted(self._r, ahead, side="right") - 1, 0, len(self._r) - 2))
-            span = self._r[i + 1] - self._r[i]
-            if span > 0.0:
-                twist[:] = self._deltas[i] / span * self.rate
+        if self.paused or self.done or ahead >= self.planned:
+            return p, q, twist
+        h = self.smoothing
+        if h > 0.0:  # from rest before the start, to rest after the end
+            before, after = max(ahead - h, 0.0), min(ahead + h, self.planned)
+            for k in range(6):
+                column = self._so_far[:, k]
+                twist[k] = (np.interp(after, self._r, column) - np.interp(before, self._r, column)) / (2 * h)
+            twist *= self.rate
+            return p, q, twist
+        i = int(np.clip(np.searchsorted(self._r, ahead, side="right") - 1, 0, len(self._r) - 2))
+        span = self._r[i + 1] - self._r[i]
+        if span > 0.0:
+            twist[:] = self._deltas[i] / span * self.rate
         return p, q, twist
 
 

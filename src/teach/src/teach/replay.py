@@ -36,6 +36,7 @@ from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 from teach.params import TeachSettings
 from teach.playback import Playback, path_distance
 from teach.program import Program, ProgramError, ProgramStore
+from teach.simplify import quaternion_angle
 from teach.timing import Limits
 
 __all__ = ["ReplayServer"]
@@ -174,14 +175,20 @@ class ReplayServer:
             raise ReplayError(f"refused: no status from contact_control on {self._cc}/status")
         return self._status
 
-    def _laws(self, press: int, force: float) -> ConfigureLawsRequest:
+    def _laws(self, press: int, force: float, turns: bool) -> ConfigureLawsRequest:
+        """Path law on every axis, force tracking on the press axis; pressing, a program that does not turn
+        the tool (`turns` False) leaves its orientation to the arm (law none, as surface following does):
+        held through the path law's orientation loop, the friction of the sliding tool made a simulated UR3
+        stick-slip (normal force std 2 N instead of 0.06 N, teach's README)."""
         s = self.s
         req = ConfigureLawsRequest()
         for i, name in enumerate(AXES):
             angular = i >= 3
             limit = s.replay_torque_limit if angular else s.replay_force_limit
             action = s.replay_exceeded_action if limit > 0.0 else 0  # nothing to exceed
-            if i == press:
+            if angular and press >= 0 and not turns:
+                law = AxisLaw(law=AxisLaw.NONE)
+            elif i == press:
                 law = AxisLaw(law=AxisLaw.FORCE_TRACKING, damping=s.replay_press_damping, target_force=force,
                               velocity=s.replay_press_approach,
                               force_limit=limit, exceeded_action=action)
@@ -227,14 +234,16 @@ class ReplayServer:
             raise ReplayError(f"could not move to the start: {err}") from None
         if not moved.success:
             raise ReplayError(f"could not move to the start: {moved.message}")
-        play = Playback(program, speed, self._limits())
+        play = Playback(program, speed, self._limits(), s.replay_smoothing)
         with self._lock:
             self._playback = play
         rate = rospy.Rate(s.replay_rate)
         for _ in range(3):  # the reference is there before the laws (the path law ends without one)
             self._send(play)
             rate.sleep()
-        answer = self._configure(self._laws(press, goal.press_force))
+        start_q = first.orientation
+        turns = any(quaternion_angle(start_q, w.orientation) > s.angle_tolerance for w in program.waypoints)
+        answer = self._configure(self._laws(press, goal.press_force, turns))
         if not answer.success:
             raise ReplayError(f"contact_control refused the replay's laws: {answer.message}")
         move_started = rospy.get_time()
@@ -300,7 +309,7 @@ class ReplayServer:
                 if play.done:
                     settle_until = settle_until or now + s.settle_time
                     if now >= settle_until:
-                        done = f"program '{program.name}' replayed at {speed:g} x its speed"
+                        done = f"program '{program.name}' replayed at {speed:.3g} x its speed"
                         took, asked = now - replay_started - s.settle_time, play.duration / speed
                         if play.planned > 1.05 * asked:
                             done += (f", slowed to the arm's limits where it was faster "
@@ -329,10 +338,14 @@ class ReplayServer:
         return Limits(
             velocity=linear,
             acceleration=get("acceleration_linear", d.acceleration_linear),
-            deceleration=get("deceleration_linear", d.deceleration_linear),
+            # Slowing down is planned as gently as speeding up: contact_control's deceleration limit (2.5
+            # m/s^2 by default) is more than a simulated UR3 followed (12 mm past the L's corner at 2 x).
+            deceleration=min(get("deceleration_linear", d.deceleration_linear),
+                             get("acceleration_linear", d.acceleration_linear)),
             angular_velocity=linear if angular is None else float(angular),
             angular_acceleration=get("acceleration_angular", d.acceleration_angular),
-            angular_deceleration=get("deceleration_angular", d.deceleration_angular),
+            angular_deceleration=min(get("deceleration_angular", d.deceleration_angular),
+                                     get("acceleration_angular", d.acceleration_angular)),
         ).scaled(self.s.replay_limit_fraction)
 
     def _keep_up(self, play: Playback, tool: np.ndarray | None, keep: list[int]) -> float:

@@ -3,9 +3,11 @@ ask more velocity or acceleration of an axis than contact_control gives, those s
 time, so the reference never runs away from the arm (it keeps the path; only the timing gives).
 
 The reference is piecewise linear between waypoints: its velocity is constant on a segment and changes at
-each waypoint, over half of the two segments around it. Stretching a segment by c divides its velocity by c
-and the accelerations around it by about c^2. Per axis, as contact_control limits them: speeding up at most
-`acceleration`, slowing down at most `deceleration`, speeds at most `velocity` (linear, then angular).
+each waypoint, over half of the two segments around it (of a moving one only: a pause spreads nothing; the
+replay's fed-forward velocity ramps over `replay_smoothing` there). Stretching a segment by c divides its
+velocity by c and the accelerations around it by about c^2. Per axis, as contact_control limits them:
+speeding up at most `acceleration`, slowing down at most `deceleration`, speeds at most `velocity` (linear,
+then angular).
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ from compliant_common.typedefs import FloatArray
 
 __all__ = ["Limits", "replay_times"]
 
-_PASSES = 200  # stretching one segment may ask its neighbours for more; a few passes settle it
+_PASSES = 400  # stretching one segment may ask its neighbours for more; the passes settle it
 
 
 @dataclass(frozen=True)
@@ -76,7 +78,10 @@ def replay_times(times: FloatArray, deltas: FloatArray, speed: float, limits: Li
     accel = np.array([limits.acceleration] * 3 + [limits.angular_acceleration] * 3)
     decel = np.array([limits.deceleration] * 3 + [limits.angular_deceleration] * 3)
     stretch = np.ones(n)
-    moving = durations > 0.0
+    # A segment that does not move (a pause) spreads no change of velocity: a step from a coasting segment
+    # into a pause happens within the coasting one (the simulated UR3 overshot a corner by 9 mm at 2 x when
+    # the pause counted).
+    moving = (durations > 0.0) & (np.abs(deltas).max(axis=1) > 1e-9)
     with np.errstate(divide="ignore", invalid="ignore"):
         fast = np.where(moving[:, None], np.abs(deltas) / (durations[:, None] * vmax), 0.0)
     stretch = np.maximum(stretch, np.nan_to_num(fast.max(axis=1), nan=1.0, posinf=1.0))
@@ -95,8 +100,11 @@ def replay_times(times: FloatArray, deltas: FloatArray, speed: float, limits: Li
             over = sum(d[i] for i in around) / 2.0
             need = _change_ok(before, after, over, accel, decel)
             if need > 1.0 + 1e-6:
+                # Half the way (in ratio) per pass: a segment stretched for one end may already be enough for
+                # the other, so stretching fully at once compounded (2 x planned slower than 1 x).
+                step = math.sqrt(need) if need > 1.01 else need
                 for i in around:
-                    stretch[i] *= need
+                    stretch[i] *= step
                     d[i] = durations[i] * stretch[i]
                     v[i] = deltas[i] / d[i]
                 changed = True

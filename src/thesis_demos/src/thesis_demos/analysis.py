@@ -12,7 +12,8 @@ import numpy as np
 
 from thesis_demos.scenarios import SURFACE_SETTLE, SURFACE_TOLERANCE, Scenario
 
-__all__ = ["CONTACT_FORCE_BOUND", "RESIDUAL_WINDOW", "SURFACE_AVERAGING", "Recording", "Verdict", "judge"]
+__all__ = ["CONTACT_FORCE_BOUND", "RESIDUAL_WINDOW", "SURFACE_AVERAGING", "Recording", "Replayed", "Verdict",
+           "judge"]
 
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 # Compliant move stops on contact without pressing harder than this [N]. Why: the arm is a stiff
@@ -30,6 +31,26 @@ SURFACE_AVERAGING = 0.05
 
 
 @dataclass
+class Replayed:
+    """One replay of the taught program (teach's ~replay action): its result and when it ran [s, recording
+    time]; `path_start` is when the path began (after the move to its start, and the press when pressing)."""
+
+    label: str
+    speed: float
+    pressed: bool
+    success: bool
+    message: str
+    path_error_rms: float  # [m] the action's result: distance from the recorded path
+    path_error_max: float  # [m]
+    force_mean: float = 0.0  # [N] the action's (contact_control's filtered force on the press axis)
+    force_min: float = 0.0
+    force_max: float = 0.0
+    start: float = float("nan")
+    path_start: float = float("nan")
+    end: float = float("nan")
+
+
+@dataclass
 class Recording:
     """Time series of one run; times are seconds since the laws were set."""
 
@@ -43,6 +64,8 @@ class Recording:
     end_conditions: dict[str, int] = field(default_factory=dict)  # axis -> AxisState end condition
     move_end_time: float | None = None
     follow_up_time: float | None = None  # when the scenario's follow-up laws were sent (surface following)
+    taught: tuple[float, float] | None = None  # teach and replay: when the recording ran [s]
+    replays: list[Replayed] = field(default_factory=list)
 
 
 @dataclass
@@ -274,10 +297,75 @@ def _surface(scenario: Scenario, rec: Recording) -> Verdict:
     return Verdict(passed, summary, figures)
 
 
+def _pressed_force(rec: Recording, start: float, end: float) -> tuple[float, float, float, float]:
+    """Mean, spread (std of SURFACE_AVERAGING means), min and max of those means of the sensor's contact
+    force on Z between `start` and `end` [s]: surface following's reading."""
+    win = _window(rec.wrench_t, start, end)
+    force = rec.contact_force[win, 2]
+    if not force.size:
+        nan = float("nan")
+        return nan, nan, nan, nan
+    smooth = _moving_mean(rec.wrench_t[win], force, SURFACE_AVERAGING)
+    return float(np.mean(force)), float(np.std(smooth)), float(np.min(smooth)), float(np.max(smooth))
+
+
+def _teach(scenario: Scenario, rec: Recording) -> Verdict:
+    """Teach and replay: the hand-guided L was recorded; each free-space replay stayed within TEACH_PATH_RMS /
+    TEACH_PATH_MAX of it (the action's own measure: the tool's distance from the recorded path); the pressed
+    one held the target within SURFACE_TOLERANCE along the path (the sensor's force, surface following's
+    rule: after SURFACE_SETTLE, the SURFACE_AVERAGING means)."""
+    from thesis_demos.scenarios import TEACH_PATH_MAX, TEACH_PATH_RMS
+
+    assert scenario.teach is not None
+    legs = scenario.teach.legs
+    figures: dict[str, float] = {}
+    problems: list[str] = []
+    taught = np.zeros(3)
+    if rec.taught is not None and rec.pose_t.size:
+        taught = _at(rec, rec.taught[1]) - _at(rec, rec.taught[0])
+    figures["taught X leg [mm]"], figures["taught Y leg [mm]"] = taught[0] * 1e3, taught[1] * 1e3
+    if not all(np.sign(taught[i]) == np.sign(legs[i]) and abs(taught[i]) >= 0.7 * abs(legs[i])
+               for i in (0, 1)):
+        problems.append(f"the taught L is {taught[0] * 1e3:.0f} x {taught[1] * 1e3:.0f} mm, not about "
+                        f"{legs[0] * 1e3:.0f} x {legs[1] * 1e3:.0f}")
+    parts = []
+    target = scenario.press_force
+    for r in rec.replays:
+        figures[f"{r.label}: path error RMS [mm]"] = r.path_error_rms * 1e3
+        figures[f"{r.label}: path error max [mm]"] = r.path_error_max * 1e3
+        if not r.success:
+            problems.append(f"{r.label}: {r.message}")
+        if r.pressed:
+            mean, spread, low, high = _pressed_force(rec, r.path_start + SURFACE_SETTLE, r.end)
+            figures.update({f"{r.label}: mean contact force [N]": mean,
+                            f"{r.label}: spread of 50 ms means (std) [N]": spread,
+                            f"{r.label}: 50 ms means min [N]": low,
+                            f"{r.label}: 50 ms means max [N]": high,
+                            f"{r.label}: controller's force min [N]": r.force_min,
+                            f"{r.label}: controller's force max [N]": r.force_max})
+            if not (abs(mean - target) <= SURFACE_TOLERANCE and target - SURFACE_TOLERANCE <= low
+                    and high <= target + SURFACE_TOLERANCE):
+                problems.append(f"{r.label}: the force left {target:g} +- {SURFACE_TOLERANCE:g} N")
+            parts.append(f"{r.label} held {mean:.2f} N ({low:.2f}..{high:.2f} N, 50 ms means) along the "
+                         f"path, {r.path_error_max * 1e3:.2f} mm max off it")
+        else:
+            if not (r.path_error_rms < TEACH_PATH_RMS and r.path_error_max < TEACH_PATH_MAX):
+                problems.append(f"{r.label}: {r.path_error_rms * 1e3:.2f} mm RMS, "
+                                f"{r.path_error_max * 1e3:.2f} mm max off the path")
+            parts.append(f"{r.label} {r.path_error_rms * 1e3:.2f} mm RMS, "
+                         f"{r.path_error_max * 1e3:.2f} mm max")
+    if len(rec.replays) < 3:
+        problems.append(f"{3 - len(rec.replays)} of the 3 replays did not run")
+    summary = (f"taught {taught[0] * 1e3:.0f} x {taught[1] * 1e3:.0f} mm by hand; replayed: "
+               + "; ".join(parts) + (f" -- {'; '.join(problems)}" if problems else ""))
+    return Verdict(not problems, summary, figures)
+
+
 _JUDGES = {
     "follower_z": _follower,
     "compliant_move_z": _compliant,
     "spring_x": _spring,
     "hybrid": _hybrid,
     "surface_following": _surface,
+    "teach_and_replay": _teach,
 }

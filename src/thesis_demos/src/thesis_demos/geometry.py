@@ -28,6 +28,7 @@ __all__ = [
     "RobotSetup",
     "demo_motions",
     "find_robot_package",
+    "fit_l",
     "load_geometry",
     "load_obstacle",
     "preflight",
@@ -46,6 +47,10 @@ SURFACE_TRAVEL = 0.04  # [m]
 SURFACE_DIRECTION = -1  # along X: toward the base
 # The hybrid move's tool tip passes at least this high over the obstacle's top [m].
 PASSING_CLEARANCE = 0.02
+# Teach and replay: the L (10 x 5 cm, along X then Y) is scaled down to fit on the obstacle's top with the
+# whole tool face this far inside its edges (the hand's push stops a few mm past the planned leg) [m] ...
+TEACH_MARGIN = 0.005
+TEACH_MIN_LEG = 0.03  # [m] ... and a shorter X leg than this is not worth the name: [CANNOT]
 
 
 class DemoConfigError(StackError):
@@ -392,12 +397,45 @@ def preflight(
             )
     elif obstacle is None or geometry.compliant_direction > 0:
         problems["surface_following"] = "it presses down on the scene's obstacle: there is none below the tip"
+    fitted = fit_l(tip, obstacle, tool_radius)
+    if isinstance(fitted, str):
+        problems["teach_and_replay"] = fitted
+    elif geometry.compliant_direction > 0:
+        problems["teach_and_replay"] = "it presses down on the scene's obstacle: there is none below the tip"
     if z < 0.03:
         for demo in ("follower_z", "spring_x", "hybrid"):
             problems.setdefault(
                 demo, f"the tool tip starts {z * 100:.1f} cm above the table (z = 0): too low"
             )
     return problems
+
+
+def fit_l(tip: Sequence[float], obstacle: Obstacle | None, tool_radius: float = 0.0,
+          legs: tuple[float, float] = (0.10, 0.05)) -> tuple[tuple[float, float], tuple[float, float]] | str:
+    """Where the teach-and-replay L goes: its first corner as an offset from the tool tip `tip` and its signed
+    legs [m], the `legs` (along X, then Y) scaled down, keeping their ratio, until the L lies centred on the
+    obstacle's top with the tool inside its edges by TEACH_MARGIN (the pressed replay slides on it); or why
+    it cannot. X runs along SURFACE_DIRECTION (toward the base), Y toward the base's XZ plane."""
+    if obstacle is None:
+        return "it presses on the scene's obstacle: there is none"
+    if not obstacle.covers(float(tip[0]), float(tip[1])):
+        return (f"the obstacle (centre {obstacle.position[0]:.3f}, {obstacle.position[1]:.3f} m) is not "
+                f"under the tool tip at ({float(tip[0]):.3f}, {float(tip[1]):.3f}) m: the L is taught over "
+                "it")
+    inset = tool_radius + TEACH_MARGIN
+    room = (obstacle.size[0] - 2 * inset, obstacle.size[1] - 2 * inset)
+    scale = min(1.0, room[0] / legs[0], room[1] / legs[1])
+    lx, ly = scale * legs[0], scale * legs[1]
+    if lx < TEACH_MIN_LEG:
+        return (f"the obstacle's top ({obstacle.size[0] * 100:.0f} x {obstacle.size[1] * 100:.0f} cm) leaves "
+                f"{max(lx, 0.0) * 100:.1f} cm for the L's {legs[0] * 100:.0f} cm leg with the tool "
+                f"({tool_radius * 2000:.0f} mm wide) on it; it needs {TEACH_MIN_LEG * 100:.0f} cm: a larger "
+                "block")
+    dx = float(SURFACE_DIRECTION)
+    dy = -1.0 if float(tip[1]) > 0.005 else 1.0  # toward y = 0 (+Y when within 5 mm of it)
+    ox, oy = obstacle.position[:2]
+    corner = (ox - dx * lx / 2.0 - float(tip[0]), oy - dy * ly / 2.0 - float(tip[1]))
+    return corner, (dx * lx, dy * ly)
 
 
 @dataclass(frozen=True)
@@ -413,6 +451,18 @@ class RobotSetup:
     def preflight(self, tip: Sequence[float]) -> dict[str, str]:
         """:func:`preflight` with this arm's obstacle and tool."""
         return preflight(self.geometry, tip, self.obstacle, self.tool_radius)
+
+    def fitted(self, scenarios: Sequence[Any], tip: Sequence[float]) -> list[Any]:
+        """`scenarios` with the teach-and-replay L fitted to this arm's block (:func:`fit_l`; unchanged
+        without a scene or when it does not fit: preflight says why)."""
+        from thesis_demos.scenarios import teach_and_replay
+
+        if not self.checks_scene:
+            return list(scenarios)
+        fitted = fit_l(tip, self.obstacle, self.tool_radius)
+        if isinstance(fitted, str):
+            return list(scenarios)
+        return [teach_and_replay(*fitted) if s.teach is not None else s for s in scenarios]
 
 
 def robot_setup(robot: str = "", demos_config: str = "") -> RobotSetup:

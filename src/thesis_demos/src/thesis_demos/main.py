@@ -1,4 +1,4 @@
-"""`rosrun thesis_demos run_demos`: the four thesis demonstrations against a running stack."""
+"""`rosrun thesis_demos run_demos`: the thesis demonstrations (and two more) against a running stack."""
 
 from __future__ import annotations
 
@@ -78,7 +78,7 @@ def unresolvable(scenario: Any, floor: NoiseFloor | None, sigmas: float,
                     f"{raw:.2g} N) reaches contact_control's {global_force:g} N global limit "
                     "(global_max_force), which would latch during the push")
     wander = TRACKING_NOISE_SIGMAS * floor.force
-    if scenario.uses_laws_service and wander > SURFACE_TOLERANCE:  # force tracking
+    if scenario.tracks_force and wander > SURFACE_TOLERANCE:
         return (f"the force the laws track wanders +-{wander:.2g} N on the sensor's noise alone "
                 f"({TRACKING_NOISE_SIGMAS:g} filtered stds), beyond this demonstration's "
                 f"+-{SURFACE_TOLERANCE:g} N")
@@ -112,7 +112,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     cannot: dict[str, str] = {}
     if setup.checks_scene:
         # Plain words before anything moves: what this arm's start pose and scene do not allow.
-        cannot = setup.preflight(runner.start_tip())
+        tip = runner.start_tip()
+        cannot = setup.preflight(tip)
+        scenarios = setup.fitted(scenarios, tip)
         for name, reason in cannot.items():
             if any(s.name == name for s in scenarios):
                 print(f"[CANNOT] {name}: this arm cannot do it as configured: {reason}", flush=True)

@@ -10,7 +10,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from thesis_demos.analysis import AXIS_INDEX, Recording, Verdict
-from thesis_demos.scenarios import Scenario
+from thesis_demos.scenarios import SURFACE_TOLERANCE, Scenario
 
 __all__ = ["plot"]
 
@@ -23,8 +23,59 @@ def _velocity(t: np.ndarray, y: np.ndarray, span: float = 0.05) -> tuple[np.ndar
     return t[step:], (y[step:] - y[:-step]) / (t[step:] - t[:-step])
 
 
+def _plot_teach(scenario: Scenario, rec: Recording, verdict: Verdict, path: str) -> None:
+    """Teach and replay: the taught L and each replay from above, their distance from it, the press force."""
+    from teach.playback import path_distance
+
+    fig, (ax_xy, ax_d, ax_f) = plt.subplots(3, 1, figsize=(9, 10), gridspec_kw={"height_ratios": [3, 2, 2]})
+    origin = np.zeros(2)
+    taught = np.zeros((0, 3))
+    if rec.taught is not None:
+        keep = (rec.pose_t >= rec.taught[0]) & (rec.pose_t <= rec.taught[1])
+        taught = rec.pose[keep]
+        origin = taught[0, :2] if len(taught) else origin
+        ax_xy.plot(*((taught[:, :2] - origin) * 1e3).T, color="black", linewidth=3, alpha=0.4,
+                   label="taught by hand")
+    for r in rec.replays:
+        end = r.end if np.isfinite(r.end) else (rec.pose_t[-1] if rec.pose_t.size else 0.0)
+        keep = (rec.pose_t >= r.path_start) & (rec.pose_t <= end)
+        if np.any(keep) and len(taught) >= 2:
+            ax_xy.plot(*((rec.pose[keep, :2] - origin) * 1e3).T, linewidth=1, label=r.label)
+            xy = [0, 1] if r.pressed else [0, 1, 2]  # pressing, Z is the force's (lower than taught)
+            distance = path_distance(rec.pose[keep][:, xy], taught[:, xy]) * 1e3
+            ax_d.plot(rec.pose_t[keep] - r.path_start, distance, label=r.label)
+        if r.pressed:  # from the replay's start: the move to it, the touch, the press, then the path
+            win = (rec.wrench_t >= r.start) & (rec.wrench_t <= end)
+            zero = r.path_start if np.isfinite(r.path_start) else r.start
+            ax_f.plot(rec.wrench_t[win] - zero, rec.contact_force[win, 2], alpha=0.4,
+                      label="Fz (sensor, tared)")
+            ax_f.plot(rec.status_t - zero, rec.force[:, 2], linewidth=1, label="Fz (contact_control)")
+            ax_f.set_xlim((r.start - zero, end - zero))
+            ax_f.axvline(0.0, color="green", linestyle=":", linewidth=1)
+            ax_f.axhspan(scenario.press_force - SURFACE_TOLERANCE, scenario.press_force + SURFACE_TOLERANCE,
+                         color="green", alpha=0.1)
+    ax_xy.set_aspect("equal", adjustable="datalim")
+    ax_xy.set_xlabel("x from the L's start [mm]")
+    ax_xy.set_ylabel("y [mm]")
+    ax_d.set_ylabel("off the taught path [mm]")
+    ax_f.set_ylabel("contact force Z [N]")
+    for ax in (ax_d, ax_f):
+        ax.set_xlabel("time since the path started [s]")
+    for ax in (ax_xy, ax_d, ax_f):
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="upper right", fontsize=8)
+    fig.suptitle(f"{scenario.title}\n{'PASS' if verdict.passed else 'FAIL'}: {verdict.summary}", fontsize=8,
+                 wrap=True)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
 def plot(scenario: Scenario, rec: Recording, verdict: Verdict, path: str) -> None:
     """Writes the figure for `scenario` to `path` (PNG)."""
+    if scenario.teach is not None:
+        _plot_teach(scenario, rec, verdict, path)
+        return
     fig, (ax_f, ax_v, ax_p) = plt.subplots(3, 1, sharex=True, figsize=(9, 7.5))
     for axis in scenario.controlled:
         i = AXIS_INDEX[axis]

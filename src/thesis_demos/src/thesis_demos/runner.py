@@ -47,6 +47,7 @@ class Names:
     contact_control: str = "/contact_control_node"
     driver: str = "/mujoco_driver"
     named_poses: str = "/named_poses"  # its ~move_to brings the arm to "start" (else the driver's ~reset)
+    teach: str = "/teach"  # teach's program_server (teach and replay)
     wrench: str = "/wrench"
     base_frame: str = ""  # empty: contact_control's ~fixed_frame
 
@@ -267,7 +268,12 @@ class DemoRunner:
 
     # --- one scenario ---
     def run(self, scenario: Scenario, sensor_frame: str) -> Recording:
-        """Brings the arm to its start pose, sets the scenario's laws, pushes, and records until done."""
+        """Brings the arm to its start pose, sets the scenario's laws, pushes, and records until done (teach
+        and replay: its own flow, thesis_demos.teach_flow)."""
+        if scenario.teach is not None:
+            from thesis_demos.teach_flow import TeachFlow
+
+            return TeachFlow(self, self.names.teach).run(scenario, sensor_frame)
         self._to_start()
         self._reset_safety()
         tare = self._tare()

@@ -1,15 +1,17 @@
-"""The four thesis demonstrations and a fifth (surface following) as data: laws, pushes, what to judge.
+"""The four thesis demonstrations, a fifth (surface following) and a sixth (teach and replay) as data: laws,
+pushes, what to judge.
 
 Pure: no rospy. Forces are in the robot's base frame [N]; velocities [m/s]; distances [m].
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from thesis_demos.geometry import SURFACE_DIRECTION, SURFACE_TRAVEL, DemoGeometry
 
-__all__ = ["SCENARIOS", "AxisLaw", "FollowUp", "Push", "Scenario", "build_scenarios", "by_name"]
+__all__ = ["SCENARIOS", "AxisLaw", "FollowUp", "Push", "Scenario", "TeachL", "build_scenarios", "by_name"]
 
 AXES = ("x", "y", "z", "rx", "ry", "rz")
 # cartesian_impedance_msgs/ControlLaw
@@ -60,6 +62,18 @@ class FollowUp:
 
 
 @dataclass(frozen=True)
+class TeachL:
+    """The L the simulated hand guides the tool along (teach and replay).
+
+    `corner`: where it starts, (x, y) offset from the start pose's tool tip [m]; `legs`: signed lengths along
+    X, then along Y [m].
+    """
+
+    corner: tuple[float, float]
+    legs: tuple[float, float]
+
+
+@dataclass(frozen=True)
 class Scenario:
     """A demonstration: laws, pushes, how long to record, and the axes that matter."""
 
@@ -75,12 +89,19 @@ class Scenario:
     # gravity_compensation.
     exceeded_action: str = "stop"
     follow_up: FollowUp | None = None  # a second request during the run (surface following: the X move)
+    teach: TeachL | None = None  # teach and replay: the L taught by hand (own flow: thesis_demos.teach_flow)
+    press_force: float = 0.0  # [N] force tracking's target on a pressed replay (0: none)
 
     @property
     def uses_laws_service(self) -> bool:
         """Force tracking exists only in compliant_control_msgs/ConfigureLaws (configure_laws)."""
         laws = list(self.laws.values()) + (list(self.follow_up.laws.values()) if self.follow_up else [])
         return any(law.law == FORCE_TRACKING for law in laws)
+
+    @property
+    def tracks_force(self) -> bool:
+        """Some part holds a contact force (force tracking): the sensor's noise must allow its tolerance."""
+        return self.uses_laws_service or self.press_force > 0.0
 
 
 # Thesis section 6.4, with the numbers it gives. Where it is silent: pushes of 5 N (follower) and
@@ -155,6 +176,7 @@ def build_scenarios(geometry: DemoGeometry | None = None) -> tuple[Scenario, ...
             controlled=("x", "z"),
         ),
         surface_following(),
+        teach_and_replay(),
     )
 
 
@@ -203,6 +225,42 @@ def surface_following() -> Scenario:
             target=SURFACE_TARGET_FORCE,
             tolerance=0.5,
         ),
+    )
+
+
+# Teach and replay (the sixth demonstration, issue #22): the simulated human guides the tool along an L (10 cm
+# along X, then 5 cm along Y, scaled to the block by geometry.fit_l) with hand-guiding on while teach's
+# program_server records it; the program is replayed in free space at its speed and at twice it, then pressing
+# on the block with Z force tracking at SURFACE_TARGET_FORCE.
+TEACH_LEGS = (0.10, 0.05)  # [m] the issue's L, along X then Y
+TEACH_PUSH = 6.0  # [N] the hand's push while guiding: 6 / 50 N/(m/s) (guide_damping_linear) = 0.12 m/s
+TEACH_PATH_RMS = 0.002  # [m] a free-space replay stays this close to the recorded path (RMS) ...
+TEACH_PATH_MAX = 0.005  # [m] ... and at most this far
+TEACH_FAST = 2.0  # the second free-space replay's speed factor
+# The pressed replay's top speed [m/s] (its speed factor: this over the taught L's top speed): surface
+# following's. Sliding on the simulated block (friction about 1 x the normal force) at a quarter of the hand's
+# 0.12 m/s (3 cm/s) stick-slipped between 2 and 15 N (50 ms means 8.9 to 12.2 N).
+TEACH_PRESS_VELOCITY = abs(SURFACE_VELOCITY)
+
+
+def teach_and_replay(
+    corner: tuple[float, float] = (0.0, 0.0),
+    legs: tuple[float, float] = (SURFACE_DIRECTION * TEACH_LEGS[0], TEACH_LEGS[1]),
+) -> Scenario:
+    """The sixth demonstration; `corner` and `legs` as geometry.fit_l gives them for an arm's block."""
+    return Scenario(
+        name="teach_and_replay",
+        title=f"Teach by hand an L of {abs(legs[0]) * 100:.0f} x {abs(legs[1]) * 100:.0f} cm, replay it at "
+        f"1 x and {TEACH_FAST:g} x, then pressing {SURFACE_TARGET_FORCE:g} N on the block",
+        laws={},
+        # What the hand pushes with (the flow pushes each leg until the tool is nearly there).
+        pushes=(Push(0.0, 0.0, (TEACH_PUSH * math.copysign(1.0, legs[0]), 0.0, 0.0)),
+                Push(0.0, 0.0, (0.0, TEACH_PUSH * math.copysign(1.0, legs[1]), 0.0))),
+        duration=240.0,  # [s] the whole flow at most
+        controlled=("x", "y", "z"),
+        exceeded_action="move_away",
+        teach=TeachL(corner, legs),
+        press_force=SURFACE_TARGET_FORCE,
     )
 
 
