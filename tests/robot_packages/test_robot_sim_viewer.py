@@ -55,7 +55,11 @@ def test_viewer_opens_a_window_and_the_arm_still_complies(ros_node, display):
     with run_launch("ur5_custom", "sim.launch", args={"viewer": "true"}, env=env) as h:
         h.wait_for_topic("/mujoco_driver/eef_pose", timeout=40)
         h.wait_for_service("/configure_cartesian_impedance", timeout=40)
-        wait_until(lambda: "MuJoCo" in _windows(display), 20, "MuJoCo's window on the display")
+        try:
+            wait_until(lambda: "MuJoCo" in _windows(display), 20, "MuJoCo's window on the display")
+        except AssertionError as err:  # once in 1310 tests (seed 777, busy cores): what the driver said
+            raise AssertionError(f"{err}; windows: {_windows(display)[-1500:]}; launch output: "
+                                 f"{h.output()[-3000:]}") from None
         assert "running headless" not in h.output(), h.output()[-3000:]
 
         pose = Collector("/mujoco_driver/eef_pose", PoseStamped)

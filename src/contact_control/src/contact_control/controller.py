@@ -451,6 +451,11 @@ class ContactControl:
         return self._rate.period
 
     @property
+    def last_wrench_time(self) -> float | None:
+        """When the newest valid wrench arrived [s] (None: none yet, or since a reset of the timing)."""
+        return self._last_rx
+
+    @property
     def wrench_timeout(self) -> float:
         """The stale timeout in use [s]: wrench_timeout, or wrench_timeout_periods periods if longer."""
         return self._timeout

@@ -20,6 +20,8 @@ from cartesian_impedance_msgs.srv import (
     ConfigureForceControlRequest,
     ConfigureForceControlResponse,
 )
+from compliant_common.diagnostics import Report
+from compliant_common.ros_diagnostics import DiagnosticsPublisher
 from compliant_common.ros_time import TimerEvent, timer
 from compliant_control_msgs.msg import AxisState, ContactControlStatus, ContactEvent, PathReference
 from compliant_control_msgs.srv import (
@@ -38,6 +40,7 @@ from contact_control.controller import CycleResult
 from contact_control.events import EVENT_NAMES
 from contact_control.events import ContactEvent as Event
 from contact_control.frames import matrix_quaternion, transform
+from contact_control.health import contact_health
 from contact_control.params import ContactControlSettings, ParamError, load_settings
 from contact_control.payload_service import PayloadServices
 from contact_control.request import CODE_NAMES
@@ -155,6 +158,8 @@ class ContactControlRos:
             s.gravity,
         )
         self._status_timer = timer(1.0 / s.status_rate, self._on_status)
+        self._health_name = rospy.resolve_name(private_ns).rstrip("/")  # contact_control_node in both layouts
+        self._health = DiagnosticsPublisher(self._health_report, s.ft_sensor_frame)
 
     # --- out ---
     def send(self, velocity: Sequence[float] | None, t: float) -> None:
@@ -326,8 +331,23 @@ class ContactControlRos:
 
     def shutdown(self) -> None:
         """Ends a running move with a zero twist."""
+        self._health.close()
         with self._lock, contextlib.suppress(rospy.ROSException):  # the publisher may already be closing
             self.emit_locked(self._stage.stop("shutdown"), rospy.get_time())
+
+    # --- health ---
+    def _health_report(self) -> Report:
+        """contact_control's /diagnostics (its own thread, once every 0.1 s; contact_control.health)."""
+        stage, ctrl = self._stage, self._stage.ctrl
+        with self._lock:  # only the reads: the words are made outside
+            r, message = stage.status()
+            last, now = ctrl.last_wrench_time, rospy.get_time()
+            period, timeout = ctrl.sample_period, ctrl.wrench_timeout
+            floor, drift = ctrl.noise_floor, ctrl.zero_drift
+            master, guiding = stage.master_fault, stage.guiding
+        age = None if last is None else max(0.0, now - last)
+        return contact_health(self._health_name, self._s, r, message, period, age, timeout, floor, drift,
+                              master, guiding)
 
     # --- status ---
     def _on_status(self, _event: TimerEvent | None) -> None:

@@ -94,6 +94,7 @@ class ContactStage:
         self._last_tick = -float("inf")
         self._request_note = ""
         self._fault_note = ""  # a clock jump or a lost master, for ~status until it is over
+        self.master_fault = ""  # why the ROS master is lost ('' while it answers)
         self._fault_shown_until = 0.0
         self._cycle_poses: dict[str, list[list[float]]] = {}
         self._last_raw: Sequence[float] = ZERO
@@ -214,11 +215,11 @@ class ContactStage:
 
     def master_lost(self, reason: str) -> Velocity | None:
         """The graph is broken: the running move ends (one zero twist to send)."""
-        self._fault_note = reason
+        self._fault_note = self.master_fault = reason
         return self.stop(reason)
 
     def master_back(self) -> None:
-        self._fault_note = ""
+        self._fault_note = self.master_fault = ""
 
     # --- publish policy ---
     def _emit(self, result: CycleResult, R_command_control: Rows | None = None) -> Velocity | None:

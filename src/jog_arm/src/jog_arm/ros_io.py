@@ -12,12 +12,15 @@ import time
 import pinocchio as pin
 import rospy
 import tf2_ros
+from compliant_common.diagnostics import Report
+from compliant_common.ros_diagnostics import DiagnosticsPublisher
 from compliant_common.typedefs import ParamMap
 from compliant_control_msgs.msg import JogStatus
 from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
+from jog_arm.health import jog_health
 from jog_arm.settings import JogSettings, SettingsError
 from jog_arm.stage import JogCycle, JogStage, log_level
 
@@ -63,6 +66,10 @@ class JogArmRos:
             rospy.Service(private_ns + "resume", Trigger, self._on_resume),
             rospy.Service(private_ns + "cycle_stats", Trigger, self._on_cycle_stats),
         ]
+        self._health_name = rospy.resolve_name(private_ns).rstrip("/")  # jog_arm_server in both layouts
+        self._counted: tuple[float, int] | None = None  # (monotonic time, cycles run) at the last report
+        self._rate: float | None = None
+        self._health = DiagnosticsPublisher(self._health_report, s.planning_frame)
         rospy.loginfo(
             "jog_arm_server: %d joints %s, tip %s, commands on %s (%s) -> %s on %s every %.4f s",
             len(stage.joint_names), stage.joint_names, s.ee_frame_name, rospy.resolve_name(s.cmd_in_topic),
@@ -179,12 +186,26 @@ class JogArmRos:
         with self._lock:
             return TriggerResponse(success=True, message=self._stage.cycle_stats())
 
+    # --- health ---
+    def _health_report(self) -> Report:
+        """jog_arm_server's /diagnostics (its own thread, every 0.1 s; jog_arm.health)."""
+        with self._lock:  # only the reads
+            cycle, cycles, master = self._stage.last_cycle, self._stage.cycles_run, self._stage.suspended
+        now = time.monotonic()
+        rate = None
+        if self._counted is not None and now - self._counted[0] >= 0.5:
+            rate = (cycles - self._counted[1]) / (now - self._counted[0])
+        if self._counted is None or now - self._counted[0] >= 0.5:
+            self._counted, self._rate = (now, cycles), rate
+        return jog_health(self._health_name, cycle, self._rate, 1.0 / self._s.pub_period, master)
+
     def master_lost(self, reason: str) -> None:
         rospy.logerr("jog_arm_server: %s: stopping the arm until it returns", reason)
 
     def shutdown(self) -> None:
         """Stops publishing and unregisters the services and publishers."""
         self.closed = True
+        self._health.close()
         for service in self._services:
             service.shutdown()
         self._cmd_pub.unregister()

@@ -110,6 +110,7 @@ class JogStage:
         self._publishers = 0
         self._fault_note = ""
         self._fault_shown_until = 0.0
+        self.suspended = ""  # why commands are refused (a lost ROS master), '' when they are not
         self.notes: list[tuple[str, str]] = []  # (level, text) for the node's log, drained by it
         self.guard: ContactGuard | None = None
         if s.contact_guard_enabled:
@@ -275,10 +276,17 @@ class JogStage:
 
     def suspend(self, reason: str) -> None:
         """Stop, and refuse commands until `unsuspend` (e.g. the ROS master is lost)."""
+        self.suspended = reason
         self.jog.suspend(reason)
 
     def unsuspend(self) -> None:
+        self.suspended = ""
         self.jog.unsuspend()
+
+    @property
+    def cycles_run(self) -> int:
+        """Cycles run since start (for the cycle rate on /diagnostics)."""
+        return self._cycles.total
 
     def cycle_stats(self) -> str:
         """Cycle timing since the previous call (or start), then a new window."""

@@ -32,6 +32,7 @@ class CycleMonitor:
     def __init__(self, period: float, keep: int = 100_000) -> None:
         self.period = float(period)
         self._errors: collections.deque[float] = collections.deque(maxlen=keep)
+        self.total = 0  # cycles since start (not reset with the window)
         self.reset()
 
     def reset(self) -> None:
@@ -45,6 +46,7 @@ class CycleMonitor:
     def tick(self, now: float) -> int:
         """Records a cycle starting at `now` [s]; returns how many cycles were missed just before it."""
         self.cycles += 1
+        self.total += 1
         last, self._last = self._last, now
         if last is None:
             return 0

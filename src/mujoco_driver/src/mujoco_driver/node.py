@@ -20,7 +20,9 @@ from typing import Any
 
 import numpy as np
 import rospy
+from compliant_common.diagnostics import Report
 from compliant_common.master import MasterWatch
+from compliant_common.ros_diagnostics import DiagnosticsPublisher
 from compliant_common.rospy_internals import drop_clock_subscription, set_rostime
 from compliant_common.runtime import tune_runtime
 from compliant_control_msgs.srv import PushEEF, PushEEFResponse
@@ -34,6 +36,7 @@ from trajectory_msgs.msg import JointTrajectory
 from mujoco_driver.commands import trajectory_points, velocity_vector
 from mujoco_driver.config import ConfigError, SceneConfig
 from mujoco_driver.emulated_driver import EmulatedDriver, resolve_profile
+from mujoco_driver.health import driver_health
 from mujoco_driver.latency import LatencyProbe
 from mujoco_driver.pacing import Pacer, RtfMeter, TrailingPublication
 from mujoco_driver.params import DriverParamError, DriverSettings, load_scene, urdf_root_link
@@ -108,6 +111,9 @@ class MujocoDriverNode:
         self._pose_msg.header.frame_id = self._base_frame
         self._clock_msg = Clock()
         self._rtf_msg = Float64()
+        self._rtf: float | None = None
+        self._dropped = 0.0
+        self._warned_now: dict[str, int] = {}
         self._stamp = rospy.Time()
         self._state_stamp = rospy.Time()  # the pending joint state's (the shared one moves with /clock)
         self._latency = LatencyProbe(horizon=s.command_timeout)
@@ -130,6 +136,7 @@ class MujocoDriverNode:
         self._pose_pub = publisher("~eef_pose", PoseStamped)
         self._rtf_pub = publisher("~rtf", Float64)
         self._latency_pub = publisher("~command_latency", Float64MultiArray)
+        self._health = DiagnosticsPublisher(self._health_report, self._base_frame)
         self._clock_pub = publisher("/clock", Clock) if s.publish_clock else None
         if self._clock_pub is not None:
             drop_clock_subscription()  # see _publish_clock
@@ -298,6 +305,7 @@ class MujocoDriverNode:
         self._pose_pub.publish(pose)
 
     def _report(self, rtf: float, dropped: float) -> None:
+        self._rtf, self._dropped = rtf, dropped  # for /diagnostics (plain attributes: atomic to read)
         self._rtf_msg.data = rtf
         self._rtf_pub.publish(self._rtf_msg)
         latencies = self._latency.take()
@@ -318,6 +326,12 @@ class MujocoDriverNode:
         if warnings != self._warned:
             rospy.logwarn("mujoco_driver: MuJoCo warnings since the last reset: %s", warnings)
             self._warned = warnings
+        self._warned_now = warnings
+
+    def _health_report(self) -> Report:
+        """The driver's /diagnostics (its own thread; mujoco_driver.health)."""
+        return driver_health(rospy.get_name(), self._rtf, self._s.real_time_factor, self._dropped,
+                             self._warned_now, self._sim.time, self._sim.mode)
 
     # ---------------------------------------------------------------- viewer
     def _open_viewer(self) -> Any:

@@ -17,6 +17,8 @@ import numpy as np
 import rosgraph
 import rospy
 import yaml
+from compliant_common.diagnostics import OK, WARN, Report
+from compliant_common.ros_diagnostics import DiagnosticsPublisher
 from compliant_control_msgs.msg import ContactControlStatus
 from compliant_control_msgs.srv import (
     MoveToJoints,
@@ -34,6 +36,8 @@ from named_poses.params import FILE_KEYS, load_settings
 from named_poses.poses import NamedPoses, PoseError, urdf_joints
 from named_poses.profile import MotionProfileError, plan_move
 from named_poses.switching import Controller, Switch, SwitchError, controller_of, plan_switch
+
+JOINTS_WARN = 1.0  # [s] no joint state for longer: WARN on /diagnostics (a move would be refused)
 
 __all__ = ["NamedPoseServer", "main"]
 
@@ -81,6 +85,10 @@ class NamedPoseServer:
                          queue_size=1, tcp_nodelay=True)
         rospy.Subscriber(settings.contact_control_status,
                          ContactControlStatus, self._on_status, queue_size=1)
+        self._joints_rx = -1.0  # monotonic time of the last joint state
+        self._moving = ""  # the move running ('' when none)
+        self._last_answer = "none yet"
+        self._health = DiagnosticsPublisher(self._health_report)
         rospy.Service("~move_to", MoveToNamedPose, self._move_to)
         rospy.Service("~move_to_joints", MoveToJoints, self._move_to_joints)
         rospy.loginfo(
@@ -89,8 +97,23 @@ class NamedPoseServer:
 
     def _on_joints(self, msg: JointState) -> None:
         with self._lock:
+            self._joints_rx = time.monotonic()
             self._positions.update(zip(msg.name, msg.position, strict=False))
             self._state_seen.notify_all()
+
+    def _health_report(self) -> Report:
+        """/diagnostics: the move running, the joint states' age (WARN past JOINTS_WARN: a move would wait),
+        the last answer."""
+        report = Report(rospy.get_name())
+        age = time.monotonic() - self._joints_rx if self._joints_rx >= 0.0 else None
+        if age is None or age > JOINTS_WARN:
+            what = "no joint state yet" if age is None else f"no joint state for {age:.1f} s"
+            report.check(WARN, f"{what} on {self._states_topic}: a move would be refused")
+        report.check(OK, f"moving to {self._moving}" if self._moving else "idle")
+        report.value("joint state age [s]", "none yet" if age is None else f"{age:.3f}")
+        report.value("last move", self._last_answer)
+        report.value("poses", ", ".join(sorted(self.poses.poses)))
+        return report
 
     def _on_status(self, msg: ContactControlStatus) -> None:
         with self._lock:
@@ -172,6 +195,17 @@ class NamedPoseServer:
         self, name: str, speed_scale: float, make_goal: Callable[[np.ndarray], np.ndarray]
     ) -> MoveToNamedPoseResponse:
         """A joint move to `make_goal(current)` (named `name` in the answers and the log)."""
+        self._moving = name
+        try:
+            answer = self._run_move(name, speed_scale, make_goal)
+        finally:
+            self._moving = ""
+        self._last_answer = ("" if answer.success else "refused or failed: ") + answer.message
+        return answer
+
+    def _run_move(
+        self, name: str, speed_scale: float, make_goal: Callable[[np.ndarray], np.ndarray]
+    ) -> MoveToNamedPoseResponse:
         scale = speed_scale or 1.0
         if not 0.0 < scale <= 1.0:
             return self._refuse(f"speed_scale must be in (0, 1], got {speed_scale}")

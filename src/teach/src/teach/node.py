@@ -15,6 +15,8 @@ from collections.abc import Sequence
 import rosbag
 import rospy
 import tf2_ros
+from compliant_common.diagnostics import OK, Report
+from compliant_common.ros_diagnostics import DiagnosticsPublisher
 from compliant_common.ros_time import MonotonicTimer, TimerEvent, timer
 from compliant_control_msgs.srv import (
     ListPrograms,
@@ -80,6 +82,18 @@ class TeachNode:
         ]
         self.replay = ReplayServer(s, self.store, robot, base_frame, tip_frame, self._tf, self._listen_tf,
                                    lambda: self.recorder.recording)
+        self._health = DiagnosticsPublisher(self._health_report)
+
+    def _health_report(self) -> Report:
+        """/diagnostics: recording (with the samples so far), replaying (with its progress), or idle; the
+        folder of the programs. Every fault here is a request's answer, so the level stays OK."""
+        report = Report(rospy.get_name())
+        with self._lock:
+            name, count = self.recorder.name, self.recorder.count
+        replaying = self.replay.describe()
+        report.check(OK, f"recording '{name}' ({count} samples)" if name else replaying or "idle")
+        report.value("programs_dir", self.store.folder)
+        return report
 
     def _listen_tf(self) -> None:
         """tf from now on (the first recording or replay starts it; idle before)."""

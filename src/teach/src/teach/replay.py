@@ -85,6 +85,15 @@ class ReplayServer:
                           rospy.Service("~resume", Trigger, self._on_resume)]
         self._server.start()
 
+    def describe(self) -> str:
+        """The replay running, in words ('' when none)."""
+        with self._lock:
+            play = self._playback
+        if play is None:
+            return ""
+        state = "paused" if play.paused else "replaying"
+        return f"{state} '{play.program.name}' at {play.speed:.3g} x, {play.progress:.0%}"
+
     # --- pause / resume ---
     def _on_pause(self, _req: TriggerRequest) -> TriggerResponse:
         with self._lock:
