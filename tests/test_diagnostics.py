@@ -122,6 +122,8 @@ def test_jog_arm_and_driver_levels():
     assert slow.level == ERROR and "real-time factor at 0.4, expected 1" in slow.message
     assert driver_health("/d", 0.2, 0.0, 0.0, {}, 3.0, "velocity").level == OK  # as fast as possible
     assert driver_health("/d", 1.0, 1.0, 0.0, {"mjWARN_BADQACC": 2}, 3.0, "position").level == WARN
+    moving = driver_health("/d", 1.0, 1.0, 0.0, {}, 3.0, "velocity", (0.0002, 0.0004))
+    assert ("end to end p50 / p99 [ms]", "0.20 / 0.40") in moving.values
 
 
 def test_show_diagnostics_says_when_nothing_publishes(ros_node):

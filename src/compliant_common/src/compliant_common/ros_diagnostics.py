@@ -37,6 +37,7 @@ class DiagnosticsPublisher:
         self._last_sent = -float("inf")
         self._last_level = -1
         self._fault: tuple[float, str] | None = None  # (monotonic time, words) of the last ERROR
+        self._clock = "simulated (/clock)" if rospy.get_param("/use_sim_time", False) else "wall"
         self._timer = MonotonicTimer(poll, self._on_poll, "diagnostics")
 
     def close(self) -> None:
@@ -55,6 +56,7 @@ class DiagnosticsPublisher:
             report.value("last fault", f"{now - since:.1f} s ago: {words}")
         else:
             report.value("last fault", "none")
+        report.value("clock", self._clock)
         status = DiagnosticStatus(level=report.level, name=report.name, message=report.message or "ok",
                                   hardware_id=self._hardware_id,
                                   values=[KeyValue(key=k, value=v) for k, v in report.values])

@@ -13,8 +13,10 @@ __all__ = ["driver_health"]
 
 
 def driver_health(name: str, rtf: float | None, target: float, dropped: float, warnings: dict[str, int],
-                  sim_time: float, mode: str) -> Report:
-    """The report; `rtf` None until first measured, `target` 0 for as fast as possible."""
+                  sim_time: float, mode: str, latency: tuple[float, float] | None = None) -> Report:
+    """The report; `rtf` None until first measured, `target` 0 for as fast as possible; `latency` the
+    stack's end to end (a wrench published -> the joint command it caused received) p50, p99 [s] over the
+    last measurement period, None while no command follows a wrench."""
     report = Report(name)
     if target > 0.0:
         level, words = rate_check(rtf, target, "real-time factor")
@@ -26,6 +28,8 @@ def driver_health(name: str, rtf: float | None, target: float, dropped: float, w
     report.value("backlog dropped [s]", dropped)
     report.value("simulated time [s]", sim_time)
     report.value("joint command mode", mode)
+    report.value("end to end p50 / p99 [ms]", "no commands following wrenches" if latency is None
+                 else f"{latency[0] * 1e3:.2f} / {latency[1] * 1e3:.2f}")
     if report.level == OK:
         report.check(OK, f"simulating, {mode} commands")
     return report

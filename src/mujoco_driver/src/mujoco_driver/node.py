@@ -112,6 +112,7 @@ class MujocoDriverNode:
         self._clock_msg = Clock()
         self._rtf_msg = Float64()
         self._rtf: float | None = None
+        self._latency_p50_p99: tuple[float, float] | None = None
         self._dropped = 0.0
         self._warned_now: dict[str, int] = {}
         self._stamp = rospy.Time()
@@ -309,6 +310,9 @@ class MujocoDriverNode:
         self._rtf_msg.data = rtf
         self._rtf_pub.publish(self._rtf_msg)
         latencies = self._latency.take()
+        if latencies:  # wrench published -> joint command received: the stack's end to end, for /diagnostics
+            ordered = sorted(latencies[1::2])
+            self._latency_p50_p99 = (ordered[len(ordered) // 2], ordered[int(0.99 * (len(ordered) - 1))])
         if latencies and self._latency_pub.get_num_connections() > 0:
             msg = self._latency_msg
             msg.layout.dim[0].size, msg.layout.dim[0].stride = len(latencies) // 2, len(latencies)
@@ -331,7 +335,7 @@ class MujocoDriverNode:
     def _health_report(self) -> Report:
         """The driver's /diagnostics (its own thread; mujoco_driver.health)."""
         return driver_health(rospy.get_name(), self._rtf, self._s.real_time_factor, self._dropped,
-                             self._warned_now, self._sim.time, self._sim.mode)
+                             self._warned_now, self._sim.time, self._sim.mode, self._latency_p50_p99)
 
     # ---------------------------------------------------------------- viewer
     def _open_viewer(self) -> Any:
