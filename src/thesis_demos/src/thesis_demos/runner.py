@@ -267,13 +267,10 @@ class DemoRunner:
         self._settle()
 
     # --- one scenario ---
-    def run(self, scenario: Scenario, sensor_frame: str) -> Recording:
-        """Brings the arm to its start pose, sets the scenario's laws, pushes, and records until done (teach
-        and replay: its own flow, thesis_demos.teach_flow)."""
-        if scenario.teach is not None:
-            from thesis_demos.teach_flow import TeachFlow
-
-            return TeachFlow(self, self.names.teach).run(scenario, sensor_frame)
+    def prepare(self, sensor_frame: str) -> float:
+        """The start pose, the safety reset, the sensor tared, the series cleared; returns when the tared
+        sensor's baseline began: 0.3 s of it before anything moves is the recorded contact force's zero (the
+        few ms of the configure call alone could leave a loaded machine without a wrench)."""
         self._to_start()
         self._reset_safety()
         tare = self._tare()
@@ -282,10 +279,18 @@ class DemoRunner:
         self._update_sensor_rotation(sensor_frame)
         for series in (self._pose, self._status, self._wrench):
             series.clear()
-        # 0.3 s of the tared sensor before the laws start: the recorded contact force's zero (it was the few
-        # ms of the configure call only, which a loaded machine could leave without a wrench).
         baseline_t = rospy.get_time()
         time.sleep(0.3)
+        return baseline_t
+
+    def run(self, scenario: Scenario, sensor_frame: str) -> Recording:
+        """Brings the arm to its start pose, sets the scenario's laws, pushes, and records until done (teach
+        and replay: its own flow, thesis_demos.teach_flow)."""
+        if scenario.teach is not None:
+            from thesis_demos.teach_flow import TeachFlow
+
+            return TeachFlow(self, self.names.teach).run(scenario, sensor_frame)
+        baseline_t = self.prepare(sensor_frame)
         self._send(scenario, scenario.laws)
         t0 = rospy.get_time()
         pushes = sorted(scenario.pushes, key=lambda p: p.start)

@@ -181,16 +181,7 @@ class TeachFlow:
     def run(self, scenario: Scenario, sensor_frame: str) -> Recording:
         assert scenario.teach is not None
         r = self.r
-        r._to_start()
-        r._reset_safety()
-        tare = r._tare()
-        if not tare.success:
-            raise RuntimeError(f"tare failed: {tare.message}")
-        r._update_sensor_rotation(sensor_frame)
-        for series in (r._pose, r._status, r._wrench):
-            series.clear()
-        baseline_t = rospy.get_time()
-        time.sleep(0.3)  # the tared sensor's zero for the recorded contact force (as DemoRunner.run)
+        baseline_t = r.prepare(sensor_frame)
         t0 = self._t0 = rospy.get_time()
         corner, legs = scenario.teach.corner, scenario.teach.legs
         self._move_along(0, corner[0])
