@@ -831,6 +831,25 @@ class ContactControl:
         self.notes.append(f"re-tared at rest: the zero had moved by {moved:.3g} N (auto_tare_drift "
                           f"{limit:g} N)")
 
+    def retune(self, s: ContactControlSettings) -> list[str]:
+        """Live tuning (params.TUNABLE): new limits, deadbands, filter cutoff and global limits from checked
+        settings, applied bumplessly: the velocity commanded last stays, and the next cycles reach the new
+        clamp within the acceleration and deceleration limits; the filter continues from its last output.
+        Returns what changed, in words."""
+        old, self.settings = self.settings, s
+        self._tuning = tuple(s.tuning(i >= 3) for i in range(6))
+        self._diff = tuple(t.diff_max for t in self._tuning)
+        self._reaction.retune(self._tuning)
+        self._watch_floor_update()
+        changed = []
+        if (s.global_max_force, s.global_max_torque) != (old.global_max_force, old.global_max_torque):
+            self.preprocessor.set_limits(s.global_max_force, s.global_max_torque)
+            changed.append(f"global limits {s.global_max_force:g} N, {s.global_max_torque:g} Nm")
+        if s.lp_filter_cutoff_freq != old.lp_filter_cutoff_freq:
+            used = self.preprocessor.set_cutoff(s.lp_filter_cutoff_freq)
+            changed.append("no filter" if used is None else f"filter cutoff {used:.3g} Hz")
+        return changed
+
     def _watch_floor_update(self) -> None:
         """The watchdog's velocity floor per axis: the minimum velocity, or the swing the sensor's noise
         alone gives a law (WATCH_NOISE_SIGMAS filtered stds / b) when larger: held against a push, a law's

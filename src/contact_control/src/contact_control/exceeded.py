@@ -43,11 +43,15 @@ class ExceededReaction:
     """
 
     def __init__(self, tuning: Sequence[AxisTuning], release_fraction: float) -> None:
-        self._tuning = tuple(tuning)
+        self.retune(tuning)
         self._release = release_fraction
         self._mode = [_IDLE] * 6
         self._laws: list[AxisLaw] = [AxisLaw()] * 6
         self._moved = [0.0] * 6
+
+    def retune(self, tuning: Sequence[AxisTuning]) -> None:
+        """New limits (live tuning); a running reaction goes on with them."""
+        self._tuning = tuple(tuning)
         self._notes: list[str] = []
         self._moving = False  # some axis has a non-zero velocity (still decelerating after its reaction)
 

@@ -17,7 +17,7 @@ from compliant_common.typedefs import ParamMap
 
 from contact_control.axes import AXES
 
-__all__ = ["PARAMETERS", "AxisTuning", "ContactControlSettings", "ParamError", "load_settings"]
+__all__ = ["PARAMETERS", "TUNABLE", "AxisTuning", "ContactControlSettings", "ParamError", "load_settings"]
 
 
 class ParamError(StackError):
@@ -385,6 +385,19 @@ class AxisTuning:
 
 
 PARAMETERS = schema_of(ContactControlSettings)
+
+
+#: Tuned live (dynamic_reconfigure, `dynparam set /contact_control_node KEY VALUE`): every change is checked
+#: as at start-up (load_settings) and applied bumplessly (ContactControl.retune; the README's "Live tuning").
+TUNABLE = (
+    "max_velocity", "acceleration_linear", "deceleration_linear", "acceleration_angular",
+    "deceleration_angular",
+    "min_velocity_linear", "min_velocity_angular", "follower_deadband_force", "follower_deadband_torque",
+    "force_tracking_deadband_force", "force_tracking_deadband_torque", "lp_filter_cutoff_freq",
+    "global_max_force", "global_max_torque", "guide_damping_linear", "guide_damping_angular",
+    "guide_max_velocity_linear", "guide_max_velocity_angular", "compliant_default_velocity_linear",
+    "move_away_velocity_linear",
+)
 
 
 def load_settings(params: ParamMap | None = None) -> ContactControlSettings:

@@ -111,6 +111,12 @@ class WrenchPreprocessor:
         """The low-pass filter's cutoff at its current design [Hz]."""
         return min(self._cutoff, 0.45 / self.design_period)
 
+    def set_cutoff(self, cutoff_freq: float) -> float | None:
+        """A new cutoff [Hz] at the filter's current design period, continuing from its last output (no step).
+        Returns the cutoff used (capped as in `redesign_filter`), None without a filter."""
+        self._cutoff = cutoff_freq
+        return self.redesign_filter(self.design_period)
+
     def redesign_filter(self, period: float) -> float | None:
         """Designs the filter anew for samples `period` [s] apart, keeping its cutoff in Hz (below 0.45 of the
         sample rate: closer to Nyquist the bilinear design degenerates); continues from its last output, so

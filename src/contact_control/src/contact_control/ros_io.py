@@ -21,6 +21,7 @@ from cartesian_impedance_msgs.srv import (
     ConfigureForceControlResponse,
 )
 from compliant_common.diagnostics import Report
+from compliant_common.live_params import LiveParams
 from compliant_common.ros_diagnostics import DiagnosticsPublisher
 from compliant_common.ros_time import TimerEvent, timer
 from compliant_control_msgs.msg import AxisState, ContactControlStatus, ContactEvent, PathReference
@@ -41,7 +42,7 @@ from contact_control.events import EVENT_NAMES
 from contact_control.events import ContactEvent as Event
 from contact_control.frames import matrix_quaternion, transform
 from contact_control.health import contact_health
-from contact_control.params import ContactControlSettings, ParamError, load_settings
+from contact_control.params import PARAMETERS, TUNABLE, ContactControlSettings, ParamError, load_settings
 from contact_control.payload_service import PayloadServices
 from contact_control.request import CODE_NAMES
 from contact_control.stage import Answer, ContactStage, Velocity
@@ -160,6 +161,7 @@ class ContactControlRos:
         self._status_timer = timer(1.0 / s.status_rate, self._on_status)
         self._health_name = rospy.resolve_name(private_ns).rstrip("/")  # contact_control_node in both layouts
         self._health = DiagnosticsPublisher(self._health_report, s.ft_sensor_frame)
+        self._live = LiveParams(PARAMETERS, TUNABLE, PARAMETERS.values_of(s), self._retune, private_ns)
 
     # --- out ---
     def send(self, velocity: Sequence[float] | None, t: float) -> None:
@@ -334,6 +336,23 @@ class ContactControlRos:
         self._health.close()
         with self._lock, contextlib.suppress(rospy.ROSException):  # the publisher may already be closing
             self.emit_locked(self._stage.stop("shutdown"), rospy.get_time())
+
+    # --- live tuning ---
+    def _retune(self, changed: dict[str, object]) -> str:
+        """dynamic_reconfigure's change: the whole settings checked as at start-up, then applied under the
+        lock (ContactStage.retune); '' or why it is refused (nothing changed then)."""
+        try:
+            settings = load_settings({**PARAMETERS.values_of(self._s), **changed})
+        except ParamError as err:
+            with self._lock:
+                self._stage.note_request(f"live tuning refused: {err}")
+            return str(err)
+        with self._lock:
+            words = self._stage.retune(settings)
+            self._s = settings
+            self._stage.note_request("tuned " + ", ".join(f"{k}={v}" for k, v in changed.items())
+                                     + (f" ({words})" if words else ""))
+        return ""
 
     # --- health ---
     def _health_report(self) -> Report:

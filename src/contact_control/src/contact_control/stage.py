@@ -213,6 +213,16 @@ class ContactStage:
         self._last_tick = -float("inf")
         return self._emit(self.ctrl.clock_jumped(t, note))
 
+    def note_request(self, note: str) -> None:
+        """A word for ~status about a request outside the laws (live tuning), until the next request."""
+        self._request_note = note
+
+    def retune(self, settings: ContactControlSettings) -> str:
+        """Live tuning with checked settings (ContactControl.retune); what changed, in words."""
+        self.settings = settings
+        self.limits = RequestLimits.from_settings(settings)
+        return "; ".join(self.ctrl.retune(settings))
+
     def master_lost(self, reason: str) -> Velocity | None:
         """The graph is broken: the running move ends (one zero twist to send)."""
         self._fault_note = self.master_fault = reason
