@@ -14,6 +14,7 @@ from collections.abc import Sequence
 from compliant_common.diagnostics import ERROR, OK, WARN, Report, rate_check
 
 from contact_control.axes import (
+    AXES,
     LAW_NAMES,
     SAFETY_NAMES,
     SAFETY_NAN,
@@ -55,8 +56,7 @@ def contact_health(name: str, s: ContactControlSettings, result: CycleResult, me
     report.value("wrench rate expected [Hz]", f"{expected:.1f} (lp_filter_delta_t)")
     report.value("newest wrench age [s]", "none yet" if wrench_age is None else f"{wrench_age:.3f}")
     report.value("stale timeout [s]", timeout)
-    active = [f"{axis}={LAW_NAMES.get(law, law)}" for axis, law in zip("x y z rx ry rz".split(), result.laws,
-                                                                     strict=True) if law]
+    active = [f"{axis}={LAW_NAMES.get(law, law)}" for axis, law in zip(AXES, result.laws, strict=True) if law]
     what = "guiding" if guiding else "move"
     report.value("move", f"{what} {result.move_id}: {', '.join(active)}" if result.move_active else "none")
     if floor is not None:

@@ -192,11 +192,10 @@ class JogArmRos:
         with self._lock:  # only the reads
             cycle, cycles, master = self._stage.last_cycle, self._stage.cycles_run, self._stage.suspended
         now = time.monotonic()
-        rate = None
-        if self._counted is not None and now - self._counted[0] >= 0.5:
-            rate = (cycles - self._counted[1]) / (now - self._counted[0])
-        if self._counted is None or now - self._counted[0] >= 0.5:
-            self._counted, self._rate = (now, cycles), rate
+        if self._counted is None or now - self._counted[0] >= 0.5:  # a new window
+            if self._counted is not None:
+                self._rate = (cycles - self._counted[1]) / (now - self._counted[0])
+            self._counted = (now, cycles)
         return jog_health(self._health_name, cycle, self._rate, 1.0 / self._s.pub_period, master)
 
     def master_lost(self, reason: str) -> None:

@@ -29,7 +29,7 @@ from compliant_control_msgs.msg import (
     ReplayProgramResult,
 )
 from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsRequest, MoveToJoints
-from contact_control.params import ContactControlSettings
+from contact_control.params import ParamError, load_settings
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 
@@ -334,28 +334,22 @@ class ReplayServer:
                 self._stop_move()
 
     def _limits(self) -> Limits:
-        """contact_control's velocity and acceleration limits (its parameters, else its defaults) times
-        `replay_limit_fraction`: what the replay's timing is planned against."""
-        d = ContactControlSettings
+        """contact_control's velocity and acceleration limits (its parameters read as it reads them) times
+        `replay_limit_fraction`: what the replay's timing is planned against.
 
-        def get(name: str, default: float | None) -> float:
-            value = rospy.get_param(f"{self._cc}/{name}", default)
-            return float(value) if value is not None else math.inf
-
-        linear = get("max_velocity", d.max_velocity)
-        angular = rospy.get_param(f"{self._cc}/max_angular_velocity", d.max_angular_velocity)
-        return Limits(
-            velocity=linear,
-            acceleration=get("acceleration_linear", d.acceleration_linear),
-            # Slowing down is planned as gently as speeding up: contact_control's deceleration limit (2.5
-            # m/s^2 by default) is more than a simulated UR3 followed (12 mm past the L's corner at 2 x).
-            deceleration=min(get("deceleration_linear", d.deceleration_linear),
-                             get("acceleration_linear", d.acceleration_linear)),
-            angular_velocity=linear if angular is None else float(angular),
-            angular_acceleration=get("acceleration_angular", d.acceleration_angular),
-            angular_deceleration=min(get("deceleration_angular", d.deceleration_angular),
-                                     get("acceleration_angular", d.acceleration_angular)),
-        ).scaled(self.s.replay_limit_fraction)
+        Raises:
+            ReplayError: contact_control's parameters are not valid (it would not have started with them).
+        """
+        try:
+            settings = load_settings(rospy.get_param(self._cc, {}))
+        except ParamError as err:
+            raise ReplayError(f"refused: contact_control's parameters: {err}") from None
+        lin, ang = settings.tuning(False), settings.tuning(True)
+        # Slowing down is planned as gently as speeding up: contact_control's deceleration limit (2.5 m/s^2 by
+        # default) is more than a simulated UR3 followed (12 mm past the L's corner at 2 x).
+        return Limits(lin.max_velocity, lin.acceleration, min(lin.deceleration, lin.acceleration),
+                      ang.max_velocity, ang.acceleration, min(ang.deceleration, ang.acceleration),
+                      ).scaled(self.s.replay_limit_fraction)
 
     def _keep_up(self, play: Playback, tool: np.ndarray | None, keep: list[int]) -> float:
         """How fast the program's clock runs now (1: the requested speed). It slows while the tool is more

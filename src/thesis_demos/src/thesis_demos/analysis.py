@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from thesis_demos.scenarios import SURFACE_SETTLE, SURFACE_TOLERANCE, Scenario
+from thesis_demos.scenarios import SURFACE_SETTLE, SURFACE_TOLERANCE, TEACH_PATH_MAX, TEACH_PATH_RMS, Scenario
 
 __all__ = ["CONTACT_FORCE_BOUND", "RESIDUAL_WINDOW", "SURFACE_AVERAGING", "Recording", "Replayed", "Verdict",
            "judge"]
@@ -257,14 +257,8 @@ def _surface(scenario: Scenario, rec: Recording) -> Verdict:
     x_law = follow_up.laws["x"] if follow_up else scenario.laws["x"]
     start = rec.follow_up_time if rec.follow_up_time is not None else float("nan")
     end = rec.move_end_time if rec.move_end_time is not None else (rec.pose_t[-1] if rec.pose_t.size else 0.0)
-    win = _window(rec.wrench_t, start + SURFACE_SETTLE, end)
-    force = rec.contact_force[win, 2]
+    mean, raw_std, spread, low, high = _pressed_force(rec, start + SURFACE_SETTLE, end)
     nan = float("nan")
-    mean = float(np.mean(force)) if force.size else nan
-    raw_std = float(np.std(force)) if force.size else nan
-    smooth = _moving_mean(rec.wrench_t[win], force, SURFACE_AVERAGING)
-    spread = float(np.std(smooth)) if smooth.size else nan
-    low, high = (float(np.min(smooth)), float(np.max(smooth))) if smooth.size else (nan, nan)
     ended_by_travel = rec.end_conditions.get("x") == 2
     known = rec.pose_t.size and rec.follow_up_time is not None
     travel_x = float(abs(_at(rec, end)[0] - _at(rec, start)[0])) if known else 0.0
@@ -297,16 +291,17 @@ def _surface(scenario: Scenario, rec: Recording) -> Verdict:
     return Verdict(passed, summary, figures)
 
 
-def _pressed_force(rec: Recording, start: float, end: float) -> tuple[float, float, float, float]:
-    """Mean, spread (std of SURFACE_AVERAGING means), min and max of those means of the sensor's contact
-    force on Z between `start` and `end` [s]: surface following's reading."""
+def _pressed_force(rec: Recording, start: float, end: float) -> tuple[float, float, float, float, float]:
+    """The sensor's contact force on Z between `start` and `end` [s] as a person reads it: mean and std of the
+    raw samples, then the std, min and max of its SURFACE_AVERAGING means (NaN for an empty window)."""
     win = _window(rec.wrench_t, start, end)
     force = rec.contact_force[win, 2]
     if not force.size:
         nan = float("nan")
-        return nan, nan, nan, nan
+        return nan, nan, nan, nan, nan
     smooth = _moving_mean(rec.wrench_t[win], force, SURFACE_AVERAGING)
-    return float(np.mean(force)), float(np.std(smooth)), float(np.min(smooth)), float(np.max(smooth))
+    return (float(np.mean(force)), float(np.std(force)), float(np.std(smooth)), float(np.min(smooth)),
+            float(np.max(smooth)))
 
 
 def _teach(scenario: Scenario, rec: Recording) -> Verdict:
@@ -314,8 +309,6 @@ def _teach(scenario: Scenario, rec: Recording) -> Verdict:
     TEACH_PATH_MAX of it (the action's own measure: the tool's distance from the recorded path); the pressed
     one held the target within SURFACE_TOLERANCE along the path (the sensor's force, surface following's
     rule: after SURFACE_SETTLE, the SURFACE_AVERAGING means)."""
-    from thesis_demos.scenarios import TEACH_PATH_MAX, TEACH_PATH_RMS
-
     assert scenario.teach is not None
     legs = scenario.teach.legs
     figures: dict[str, float] = {}
@@ -336,7 +329,7 @@ def _teach(scenario: Scenario, rec: Recording) -> Verdict:
         if not r.success:
             problems.append(f"{r.label}: {r.message}")
         if r.pressed:
-            mean, spread, low, high = _pressed_force(rec, r.path_start + SURFACE_SETTLE, r.end)
+            mean, _raw, spread, low, high = _pressed_force(rec, r.path_start + SURFACE_SETTLE, r.end)
             figures.update({f"{r.label}: mean contact force [N]": mean,
                             f"{r.label}: spread of 50 ms means (std) [N]": spread,
                             f"{r.label}: 50 ms means min [N]": low,

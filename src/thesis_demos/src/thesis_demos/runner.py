@@ -225,19 +225,17 @@ class DemoRunner:
     def _settle(self, timeout: float = 10.0, window: float = 0.3, tolerance: float = 2e-4) -> None:
         """Waits until the tool has moved less than `tolerance` over `window` seconds."""
 
-        def still() -> bool:
-            with self._pose.lock:
-                if not self._pose.t or self._pose.t[-1] - self._pose.t[0] < window:
-                    return False
-                recent = [
-                    v
-                    for t, v in zip(self._pose.t, self._pose.v, strict=True)
-                    if t > self._pose.t[-1] - window
-                ]
-            return float(np.ptp(np.asarray(recent), axis=0).max()) < tolerance
-
         self._pose.clear()
-        self._wait(still, timeout, "the arm to settle")
+        self._wait(lambda: self.still(window, tolerance), timeout, "the arm to settle")
+
+    def still(self, window: float = 0.3, tolerance: float = 2e-4) -> bool:
+        """Whether the tool has moved less than `tolerance` [m] over the last `window` seconds recorded."""
+        with self._pose.lock:
+            if not self._pose.t or self._pose.t[-1] - self._pose.t[0] < window:
+                return False
+            since = self._pose.t[-1] - window
+            recent = [v for t, v in zip(self._pose.t, self._pose.v, strict=True) if t > since]
+        return float(np.ptp(np.asarray(recent), axis=0).max()) < tolerance
 
     def _move_state(self) -> tuple[bool, dict[str, int]]:
         """(whether the move or its exceeded action, e.g. moving away, still runs; end condition per axis)."""

@@ -70,17 +70,6 @@ class TeachFlow:
         with self.r._pose.lock:
             return np.asarray(self.r._pose.v[-1], dtype=float)
 
-    def _at_rest(self, window: float = 0.3, tolerance: float = 2e-4) -> bool:
-        with self.r._pose.lock:
-            t, v = self.r._pose.t, self.r._pose.v
-            if not t or t[-1] - t[0] < window:
-                return False
-            k = len(t) - 1
-            while k > 0 and t[k - 1] > t[-1] - window:
-                k -= 1
-            recent = np.asarray(v[k:])
-        return float(np.ptp(recent, axis=0).max()) < tolerance
-
     def _wait(self, predicate: Callable[[], object], timeout: float, what: str) -> None:
         self.r._wait(predicate, timeout, what)
 
@@ -107,7 +96,7 @@ class TeachFlow:
                 f"the move to the L's corner along {name} ended by condition {ended}, not by its "
                 "travel (see contact_control's ~status)"
             )
-        self._wait(self._at_rest, 10.0, "the tool to rest at the corner")
+        self._wait(self.r.still, 10.0, "the tool to rest at the corner")
 
     def _push_leg(self, axis: int, leg: float) -> None:
         """The hand pushes along `axis` with TEACH_PUSH until the tool is about `leg` [m] from its start."""
@@ -128,8 +117,8 @@ class TeachFlow:
             if abs(tip[axis] - start[axis]) >= abs(leg) - speed * COAST_TIME:
                 break
         self.r._push(PushEEFRequest(duration=0.0))  # let go
-        self._wait(lambda: not self._at_rest(), 5.0, "the guided tool to move")
-        self._wait(self._at_rest, 15.0, "the guided tool to come to rest")
+        self._wait(lambda: not self.r.still(), 5.0, "the guided tool to move")
+        self._wait(self.r.still, 15.0, "the guided tool to come to rest")
 
     def _replay_once(self, label: str, speed: float, press: bool, t0: float, target: float) -> Replayed:
         path_start = [math.nan]
