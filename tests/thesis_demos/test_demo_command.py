@@ -3,6 +3,7 @@ speaking as ur_robot_driver (125 Hz), ur5_custom's hardware.launch on top, the d
 driver's wrench; the run is recorded into demo.bag."""
 
 import pathlib
+import re
 import subprocess
 
 import numpy as np
@@ -59,8 +60,11 @@ def test_teach_and_replay_on_a_generated_arm(tmp_path):
                          env={**os.environ, "HOME": str(home)})
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
     assert "[PASS] teach_and_replay: taught -" in run.stdout
-    for label in ("free space 1x", "free space 2x", "pressing 10 N at 0.08"):
-        assert f"  {label}" in run.stdout
+    for label in ("free space 1x", "free space 2x"):
+        assert f"  {label}: program" in run.stdout
+    # Pressing at the fraction of the taught speed that makes its top speed 1 cm/s (the hand's varies).
+    pressed = r"^  pressing 10 N at 0\.\d+x: program .* force \d+\.\d\d N"
+    assert re.search(pressed, run.stdout, re.M), run.stdout
     assert (home / ".ros" / "compliant_programs" / "thesis_demos_teach_and_replay.yaml").exists()
     report = (tmp_path / "out" / "report.md").read_text()
     assert "teach_and_replay.png" in report and "free space 2x: path error max [mm]" in report

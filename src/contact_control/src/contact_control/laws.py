@@ -12,7 +12,8 @@ the law was set [m] ([rad]), V the commanded velocity [m/s] ([rad/s]):
 - force tracking: V = (F - F_target) / b, so the axis presses until the contact force F reaches the target
   (F as the follower reads it: a table under the tool pushes +Z, so pressing down with 10 N is F_target 10).
   No deadband around zero force (free air must move the tool toward the contact), but V = 0 while
-  |F - F_target| <= `track_deadband`, and no minimum velocity (a stiff surface needs a large b, so small
+  |F - F_target| <= `track_deadband` and outside it V = (F - F_target -+ track_deadband) / b, continuous at
+  the band's edge; no minimum velocity (a stiff surface needs a large b, so small
   corrections are slow ones). Out of contact (F short of `contact_fraction` of the target, on the target's
   side) the axis approaches at the law's approach speed (`velocity`) toward the contact: (F - F_target) / b
   with a b fit for a stiff surface would creep through free air, with a small b it would hit the surface.
@@ -112,9 +113,12 @@ def law_velocity(law: AxisLaw, tuning: AxisTuning, force: float, travel: float) 
         return v
     if kind == LAW_FORCE_TRACKING:
         error = force - law.target
-        if -tuning.track_deadband <= error <= tuning.track_deadband:
+        band = tuning.track_deadband
+        if -band <= error <= band:
             return 0.0
-        v = error / law.damping
+        # Continuous at the band's edge: stepping to band / b there made a relay whose steps, held for the
+        # filter's delay against a stiff surface, swung the force by +-2 N (README, *Force tracking*).
+        v = (error - math.copysign(band, error)) / law.damping
         target = law.target
         # Out of contact (the force short of contact_fraction of the target on the target's side): toward
         # it at the approach speed, which sets the overshoot on touching; never faster for a small b.

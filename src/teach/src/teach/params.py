@@ -68,6 +68,13 @@ class TeachSettings:
         "instead of stepping at a waypoint (a step jerks the tool: pressing on the simulated block, each "
         "waypoint's step swung the force by 3-4 N)",
     )
+    replay_press_smoothing: float = param(
+        0.5, unit="s", ge=0.0,
+        doc="`replay_smoothing` for a pressed replay: each joint's servo lags a change of speed by its own "
+        "time, which moves the tool along the press axis, and on a stiff surface that is force (UR3 on the "
+        "simulated block, 50 ms means of the sensor, a busy machine: 0.1 s 8.8-10.9 N, 0.5 s 9.5-10.7 N). "
+        "Free replays keep `replay_smoothing`: 0.5 s there put them 3 mm off the path",
+    )
     replay_lead: float = param(
         0.03, unit="s", ge=0.0,
         doc="the fed-forward velocity is the path's this far ahead: the command path's latency (jogger, "

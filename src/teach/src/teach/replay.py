@@ -243,7 +243,8 @@ class ReplayServer:
             raise ReplayError(f"could not move to the start: {err}") from None
         if not moved.success:
             raise ReplayError(f"could not move to the start: {moved.message}")
-        play = Playback(program, speed, self._limits(), s.replay_smoothing)
+        smoothing = s.replay_press_smoothing if press >= 0 else s.replay_smoothing
+        play = Playback(program, speed, self._limits(), smoothing)
         with self._lock:
             self._playback = play
         rate = rospy.Rate(s.replay_rate)

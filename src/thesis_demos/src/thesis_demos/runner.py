@@ -17,7 +17,7 @@ import numpy as np
 import rospy
 import tf2_ros
 from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
-from compliant_control_msgs.msg import ContactControlStatus
+from compliant_control_msgs.msg import ContactControlStatus, ContactEvent
 from compliant_control_msgs.srv import (
     ConfigureLaws,
     ConfigureLawsRequest,
@@ -168,6 +168,7 @@ class DemoRunner:
         self._wrench = _Series(3)
         self._status_lock = threading.Lock()
         self._last_status: ContactControlStatus | None = None
+        self._move_ends: list[float] = []  # stamps of contact_control's move_ended events [s]
         self._sensor_rotation: np.ndarray | None = None
         self._subs = [
             rospy.Subscriber(f"{drv}/eef_pose", PoseStamped, self._on_pose, queue_size=100, tcp_nodelay=True),
@@ -175,6 +176,7 @@ class DemoRunner:
                 f"{cc}/status", ContactControlStatus, self._on_status, queue_size=100, tcp_nodelay=True
             ),
             rospy.Subscriber(names.wrench, WrenchStamped, self._on_wrench, queue_size=100, tcp_nodelay=True),
+            rospy.Subscriber(f"{cc}/events", ContactEvent, self._on_event, queue_size=20, tcp_nodelay=True),
         ]
         self._wait(lambda: self._pose.t and self._last_status is not None, timeout, "eef_pose and status")
 
@@ -188,6 +190,19 @@ class DemoRunner:
         self._status.add(msg.header.stamp.to_sec(), (f.x, f.y, f.z, v.x, v.y, v.z))
         with self._status_lock:
             self._last_status = msg
+
+    def _on_event(self, msg: ContactEvent) -> None:
+        if msg.type == ContactEvent.MOVE_ENDED:
+            with self._status_lock:
+                self._move_ends.append(msg.header.stamp.to_sec())
+
+    def _ended_at(self, seen: float) -> float:
+        """When the move the runner saw end at `seen` [s, rospy time] ended: the last move_ended event's stamp
+        up to then (its cycle), else `seen`. Polling status saw it up to a status period late, more on a busy
+        machine, and the force's jolt as the tool stops then fell inside the judged window."""
+        with self._status_lock:
+            stamps = [t for t in self._move_ends if t <= seen]
+        return stamps[-1] if stamps else seen
 
     def _on_wrench(self, msg: WrenchStamped) -> None:
         if self._sensor_rotation is None:
@@ -321,6 +336,8 @@ class DemoRunner:
             time.sleep(0.005)
         _, ends = self._move_state()
         self._stop()
+        if end_time is not None:
+            end_time = self._ended_at(end_time + t0) - t0
         recording = self._recording(t0, baseline_t, ends, end_time)
         recording.follow_up_time = follow_up_time
         return recording
