@@ -77,7 +77,9 @@ class LiveParams:
         self._values = dict(kind.defaults)  # the current values, typed as dynamic_reconfigure carries them
         self._apply = apply
         self.refused = ""  # why the last change was refused ('' after an accepted one)
-        self._server = Server(kind, self._on_config, namespace)
+        # Resolved here: the Server joins "~" and "/" into "~/name", which rospy resolves as the global
+        # "/name" (parameters of every node in one place, each reading the others').
+        self._server = Server(kind, self._on_config, rospy.resolve_name(namespace).rstrip("/") + "/")
 
     def _on_config(self, config: dict[str, Any], _level: int) -> dict[str, Any]:
         changed = {n: config[n] for n in self._names if config[n] != self._values[n]}

@@ -48,12 +48,8 @@ class CommandState:
     def __init__(self, settings: JogSettings, frames: CommandFrames) -> None:
         self._frames = frames
         self._unitless = settings.command_in_type == "unitless"
-        if self._unitless:
-            self._unit_scales = (float(settings.scale_linear), float(settings.scale_rotational))
-        else:
-            self._unit_scales = (1.0, 1.0)
+        self.retune(settings)
         self._default_frame = settings.default_cmd_frame
-        self._cmd_timeout = settings.incoming_cmd_timeout
         self._state_timeout = settings.joint_state_timeout
         # Root-axes twists are weighted like the solver's Jacobian: linear part / singularity_length_scale.
         self._inv_length = 1.0 / settings.singularity_length_scale
@@ -70,6 +66,14 @@ class CommandState:
         #: Whether :meth:`pause` is in effect.
         self.paused = False
 
+
+    def retune(self, settings: JogSettings) -> None:
+        """Live tuning: the unitless scales and the command timeout (the next command is scaled anew)."""
+        if self._unitless:
+            self._unit_scales = (float(settings.scale_linear), float(settings.scale_rotational))
+        else:
+            self._unit_scales = (1.0, 1.0)
+        self._cmd_timeout = settings.incoming_cmd_timeout
     def set(self, twist: Sequence[float], frame: str, now: float) -> CommandResult:
         """Accepts (or refuses, see `JogCalcs.set_command`) `twist` in `frame` received at `now` [s]."""
         if self.paused:

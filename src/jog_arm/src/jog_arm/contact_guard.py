@@ -74,6 +74,13 @@ class ContactGuard:
         timeout: float,
         relief_speed: float = 0.005,
     ) -> None:
+        self.retune(max_force, slow_force, slow_speed, timeout, relief_speed)
+        self._blocked = False  # reached max_force: into-contact motion stays blocked until below slow_force
+        self._relieving = False  # reached max_force: a push into the contact backs off until RELIEF_RELEASE
+
+    def retune(self, max_force: float, slow_force: float, slow_speed: float, timeout: float,
+               relief_speed: float) -> None:
+        """New thresholds, checked as at start-up (nothing changes on a ValueError); a block stays."""
         for name, value in (("max_force", max_force), ("slow_speed", slow_speed), ("timeout", timeout),
                             ("relief_speed", relief_speed)):
             if not (value > 0.0 and math.isfinite(value)):
@@ -86,8 +93,6 @@ class ContactGuard:
         self.slow_speed = slow_speed
         self.timeout = timeout
         self.relief_speed = relief_speed
-        self._blocked = False  # reached max_force: into-contact motion stays blocked until below slow_force
-        self._relieving = False  # reached max_force: a push into the contact backs off until RELIEF_RELEASE
 
     def limit(self, twist: Sequence[float], force: Sequence[float] | None, age: float = 0.0) -> GuardResult:
         """The twist the guard lets through.

@@ -62,15 +62,12 @@ class DampedSolver:
         self._period = settings.pub_period
         # With publish_on_command a step lasts until the next twist, not pub_period: nothing to straighten.
         self._straighten_step = math.inf if settings.publish_on_command else _STRAIGHTEN_STEP
-        self._threshold = settings.singularity_threshold
-        self._hard_stop = settings.hard_stop_singularity_threshold
+        self.retune(settings)
         self._posture_fixed = posture is not None
         self._ns_gain = settings.nullspace_gain
         # gain x posture, so the pull gain·(posture - q) costs two vector operations per cycle.
         self._gain_posture = self._ns_gain * (np.zeros(n) if posture is None else posture)
         self._redundant = n > 6 and settings.nullspace_gain > 0.0
-        self._damping2 = settings.pinv_damping**2
-        self._damping_threshold = settings.pinv_damping_threshold
         self._inv_length = 1.0 / settings.singularity_length_scale
         self._jjt = np.zeros((6, 6))
         self._displacement = np.zeros(6)
@@ -82,6 +79,13 @@ class DampedSolver:
         self.q_arr = np.zeros(n)
         self._geom = Geometry()
 
+
+    def retune(self, settings: JogSettings) -> None:
+        """Live tuning: the singularity thresholds and the pseudo-inverse's damping (from the next cycle)."""
+        self._threshold = settings.singularity_threshold
+        self._hard_stop = settings.hard_stop_singularity_threshold
+        self._damping2 = settings.pinv_damping**2
+        self._damping_threshold = settings.pinv_damping_threshold
     def start_motion(self, q_arr: FloatArray) -> None:
         """Motion starts at `q_arr`: without a configured posture, the null space pulls back toward it."""
         if not self._posture_fixed:

@@ -30,13 +30,17 @@ class LowPassFilter:
     """
 
     def __init__(self, coeff: float, size: int) -> None:
+        self.set_coeff(coeff)
+        self._size = size
+        self._x_prev = [0.0] * size
+        self._y_prev = [0.0] * size
+
+    def set_coeff(self, coeff: float) -> None:
+        """A new c, continuing from the filter's memories (live tuning: no jump in its output)."""
         if not coeff >= 1.0:
             raise ValueError(f"low_pass_filter_coeff must be >= 1, got {coeff}")
         self._gain = 1.0 / (1.0 + coeff)
         self._feedback = 1.0 - coeff
-        self._size = size
-        self._x_prev = [0.0] * size
-        self._y_prev = [0.0] * size
 
     def reset(self, value: Sequence[float] | float = 0.0) -> None:
         """Starts from steady state at `value` (both memories), so the next output has no jump."""

@@ -166,6 +166,15 @@ class JogCalcs:
         self._zeros = (0.0,) * n
         self._condition = math.nan  # of the last Jacobian computed by a step
 
+    def retune(self, settings: JogSettings) -> None:
+        """Live tuning (settings.TUNABLE, already validated): unitless scales, command timeout, twist filter
+        (continuing from its memories), singularity thresholds and damping. The joint limiter still bounds
+        every joint's acceleration, so no change steps the arm's velocity beyond it."""
+        self.settings = settings
+        self.command.retune(settings)
+        self._filter.set_coeff(settings.low_pass_filter_coeff)
+        self.solver.retune(settings)
+
     # --- inputs ---------------------------------------------------------------------------------------
 
     def set_joint_state(self, positions: Sequence[float], now: float | None = None) -> None:

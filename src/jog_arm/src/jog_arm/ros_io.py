@@ -13,6 +13,7 @@ import pinocchio as pin
 import rospy
 import tf2_ros
 from compliant_common.diagnostics import Report
+from compliant_common.live_params import LiveParams
 from compliant_common.ros_diagnostics import DiagnosticsPublisher
 from compliant_common.typedefs import ParamMap
 from compliant_control_msgs.msg import JogStatus
@@ -21,7 +22,7 @@ from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from jog_arm.health import jog_health
-from jog_arm.settings import JogSettings, SettingsError
+from jog_arm.settings import PARAMETERS, TUNABLE, JogSettings, SettingsError
 from jog_arm.stage import JogCycle, JogStage, log_level
 
 __all__ = ["JogArmRos", "load"]
@@ -70,6 +71,8 @@ class JogArmRos:
         self._counted: tuple[float, int] | None = None  # (monotonic time, cycles run) at the last report
         self._rate: float | None = None
         self._health = DiagnosticsPublisher(self._health_report, s.planning_frame)
+        self._prefix = self._health_name.lstrip("/") + "/"
+        self._live = LiveParams(PARAMETERS, TUNABLE, PARAMETERS.values_of(s), self._retune, private_ns)
         rospy.loginfo(
             "jog_arm_server: %d joints %s, tip %s, commands on %s (%s) -> %s on %s every %.4f s",
             len(stage.joint_names), stage.joint_names, s.ee_frame_name, rospy.resolve_name(s.cmd_in_topic),
@@ -185,6 +188,18 @@ class JogArmRos:
         """Cycle timing since the previous call (or start), then starts a new window."""
         with self._lock:
             return TriggerResponse(success=True, message=self._stage.cycle_stats())
+
+    # --- live tuning ---
+    def _retune(self, changed: dict[str, object]) -> str:
+        """dynamic_reconfigure's change, checked as at start-up and applied under the lock from the next
+        cycle; '' or why it is refused (nothing changed then)."""
+        with self._lock:
+            try:
+                settings = self._stage.settings.retuned(changed, self._prefix)
+            except SettingsError as err:
+                return str(err)
+            self._stage.retune(settings)
+        return ""
 
     # --- health ---
     def _health_report(self) -> Report:

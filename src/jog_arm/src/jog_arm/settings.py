@@ -19,6 +19,7 @@ __all__ = [
     "COMMAND_OUT_TYPES",
     "INTEGRATE_FROM",
     "PARAMETERS",
+    "TUNABLE",
     "JogSettings",
     "JointLimitOverride",
     "SettingsError",
@@ -287,6 +288,23 @@ class JogSettings:
                 f"{len(self.joint_names)} joint_names"
             )
 
+    def retuned(self, changed: Mapping[str, object], prefix: str = "jog_arm_server/") -> JogSettings:
+        """These settings with `changed` (TUNABLE keys) checked as at start-up (live tuning).
+
+        Raises:
+            SettingsError: A key that is not tunable or a value out of its range, named.
+        """
+        for key in changed:
+            if key not in TUNABLE:
+                raise SettingsError(f"{prefix}{key} cannot be tuned live (tunable: {', '.join(TUNABLE)})")
+        try:
+            values = PARAMETERS.convert({k: v for k, v in changed.items()})
+        except SchemaError as err:
+            raise SettingsError(_message(prefix, err)) from None
+        settings = PARAMETERS.build(JogSettings, {**PARAMETERS.values_of(self), **values})
+        settings.validate(prefix)
+        return settings
+
     @property
     def default_cmd_frame(self) -> str:
         """Frame of commands whose header leaves the frame empty."""
@@ -294,6 +312,15 @@ class JogSettings:
 
 
 PARAMETERS = schema_of(JogSettings)
+
+# What dynamic_reconfigure may change while the node runs (README, *Look and tune*): read per cycle or by
+# parts that take a new value without a restart. Joint limits, periods, topics and frames are start-up only.
+TUNABLE = (
+    "scale/linear", "scale/rotational", "low_pass_filter_coeff", "incoming_cmd_timeout",
+    "singularity_threshold", "hard_stop_singularity_threshold", "pinv_damping", "pinv_damping_threshold",
+    "contact_guard_max_force", "contact_guard_slow_force", "contact_guard_slow_speed",
+    "contact_guard_timeout", "contact_guard_relief_speed",
+)
 
 
 def _message(prefix: str, err: SchemaError) -> str:

@@ -122,6 +122,16 @@ class JogStage:
         self._guard_note = ""
         self._guard_acted = False
 
+    def retune(self, settings: JogSettings) -> None:
+        """Live tuning: settings validated by `JogSettings.retuned` (TUNABLE keys only), applied from the next
+        cycle (the caller holds the node's lock)."""
+        if self.guard is not None:
+            self.guard.retune(settings.contact_guard_max_force, settings.contact_guard_slow_force,
+                              settings.contact_guard_slow_speed, settings.contact_guard_timeout,
+                              settings.contact_guard_relief_speed)
+        self.jog.retune(settings)
+        self.settings = settings
+
     # --- inputs ---
     def on_joint_state(self, names: Sequence[str], positions: Sequence[float], t: float) -> bool:
         """A JointState's names and positions received at `t` [s]. False if it is not usable (a controlled
