@@ -142,3 +142,17 @@ def angle_deg(a: np.ndarray, b: np.ndarray) -> float:
     """Angle between two vectors in degrees."""
     cos = float(np.dot(a, b) / (np.linalg.norm(a) * np.linalg.norm(b)))
     return float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
+
+
+def ur5_launch_override(directory: pathlib.Path, topics: str) -> pathlib.Path:
+    """An override YAML for jog_arm.launch: the UR5 tip, unitless twists (scale 0.1 m/s, 0.3 rad/s) in,
+    Float64MultiArray out every 4 ms; topics `topics`/joint_states, /twist and /speed."""
+    path = directory / "ur5_jog.yaml"
+    path.write_text(
+        "ee_frame_name: tool0\nplanning_frame: base_link\ncommand_in_type: unitless\n"
+        "scale: {linear: 0.1, rotational: 0.3}\ncommand_out_type: velocity_array\n"
+        f"joint_topic: {topics}/joint_states\ncmd_in_topic: {topics}/twist\ncmd_out_topic: {topics}/speed\n"
+        "pub_period: 0.004\nincoming_cmd_timeout: 0.5\nintegrate_from: measured\n"
+    )
+    return path
+

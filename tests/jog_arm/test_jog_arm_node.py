@@ -16,7 +16,7 @@ from harness.bags import replay_bag, typestore, write_bag
 from harness.launch import run_launch, run_node
 from harness.streams import Repeater
 from harness.waiting import Collector, wait_until
-from jog_arm_testing import PANDA, UR5, angle_deg
+from jog_arm_testing import PANDA, UR5, angle_deg, ur5_launch_override
 
 from jog_arm import ArmModel, StatusCode
 
@@ -197,13 +197,7 @@ def test_velocity_output_tf_frame_pause_and_launch_file(ros_node, tmp_path) -> N
 
     rospy = ros_node
     rospy.set_param("/robot_description", UR5.urdf)
-    override = tmp_path / "ur5_jog.yaml"
-    override.write_text(
-        "ee_frame_name: tool0\nplanning_frame: base_link\ncommand_in_type: unitless\n"
-        "scale: {linear: 0.1, rotational: 0.3}\ncommand_out_type: velocity_array\n"
-        "joint_topic: /jog_ur5/joint_states\ncmd_in_topic: /jog_ur5/twist\ncmd_out_topic: /jog_ur5/speed\n"
-        "pub_period: 0.004\nincoming_cmd_timeout: 0.5\nintegrate_from: measured\n"
-    )
+    override = ur5_launch_override(tmp_path, "/jog_ur5")
     # A camera frame only tf knows: x along the base's y.
     broadcaster = tf2_ros.StaticTransformBroadcaster()
     tf = TransformStamped()

@@ -11,7 +11,7 @@ import pytest
 from harness.launch import run_launch
 from harness.streams import Repeater
 from harness.waiting import Collector, wait_until
-from jog_arm_testing import UR5
+from jog_arm_testing import UR5, ur5_launch_override
 
 from jog_arm import ArmModel
 
@@ -39,13 +39,7 @@ def test_a_new_speed_scale_applies_without_a_step_and_bad_values_are_refused(ros
 
     rospy = ros_node
     rospy.set_param("/robot_description", UR5.urdf)
-    override = tmp_path / "ur5_jog.yaml"
-    override.write_text(
-        "ee_frame_name: tool0\nplanning_frame: base_link\ncommand_in_type: unitless\n"
-        "scale: {linear: 0.1, rotational: 0.3}\ncommand_out_type: velocity_array\n"
-        "joint_topic: /jog_tune/joint_states\ncmd_in_topic: /jog_tune/twist\ncmd_out_topic: /jog_tune/speed\n"
-        "pub_period: 0.004\nincoming_cmd_timeout: 0.5\nintegrate_from: measured\n"
-    )
+    override = ur5_launch_override(tmp_path, "/jog_tune")
     model = ArmModel(UR5.urdf, UR5.tip)
     joints = rospy.Publisher("/jog_tune/joint_states", JointState, queue_size=1, latch=True)
     driver = Repeater(joints).start(JointState(name=list(model.joint_names), position=list(UR5.start)), 100.0)
