@@ -5,8 +5,6 @@ cleanly with the window still open."""
 from __future__ import annotations
 
 import os
-import shutil
-import subprocess
 
 import numpy as np
 import pytest
@@ -18,34 +16,17 @@ from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceCo
 from compliant_control_msgs.msg import ContactControlStatus
 from compliant_control_msgs.srv import PushEEF, PushEEFRequest
 from geometry_msgs.msg import PoseStamped
+from harness.display import HAVE_XVFB, NO_XVFB, private_display, windows
 from harness.launch import run_launch
 from harness.waiting import Collector, wait_until
 
-pytestmark = pytest.mark.skipif(not (shutil.which("Xvfb") and shutil.which("xwininfo")),
-                                reason="needs Xvfb and xwininfo (scripts/bootstrap installs xvfb, x11-utils)")
+pytestmark = pytest.mark.skipif(not HAVE_XVFB, reason=NO_XVFB)
 
 
 @pytest.fixture
 def display():
-    """A private X display; Xvfb picks a free number itself (-displayfd), so runs cannot collide."""
-    read_end, write_end = os.pipe()
-    xvfb = subprocess.Popen(["Xvfb", "-displayfd", str(write_end), "-screen", "0", "1024x768x24",
-                             "-nolisten", "tcp"], pass_fds=(write_end,), stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
-    os.close(write_end)
-    try:
-        with os.fdopen(read_end) as pipe:
-            number = pipe.readline().strip()  # written once the server accepts connections
-        assert number, "Xvfb did not start"
-        yield f":{number}"
-    finally:
-        xvfb.terminate()
-        xvfb.wait(timeout=10)
-
-
-def _windows(display: str) -> str:
-    return subprocess.run(["xwininfo", "-root", "-tree"], capture_output=True, text=True, timeout=10,
-                          env={**os.environ, "DISPLAY": display}).stdout
+    with private_display() as name:
+        yield name
 
 
 def test_viewer_opens_a_window_and_the_arm_still_complies(ros_node, display):
@@ -56,9 +37,9 @@ def test_viewer_opens_a_window_and_the_arm_still_complies(ros_node, display):
         h.wait_for_topic("/mujoco_driver/eef_pose", timeout=40)
         h.wait_for_service("/configure_cartesian_impedance", timeout=40)
         try:
-            wait_until(lambda: "MuJoCo" in _windows(display), 20, "MuJoCo's window on the display")
+            wait_until(lambda: "MuJoCo" in windows(display), 20, "MuJoCo's window on the display")
         except AssertionError as err:  # once in 1310 tests (seed 777, busy cores): what the driver said
-            raise AssertionError(f"{err}; windows: {_windows(display)[-1500:]}; launch output: "
+            raise AssertionError(f"{err}; windows: {windows(display)[-1500:]}; launch output: "
                                  f"{h.output()[-3000:]}") from None
         assert "running headless" not in h.output(), h.output()[-3000:]
 
@@ -85,7 +66,7 @@ def test_viewer_opens_a_window_and_the_arm_still_complies(ros_node, display):
             wait_until(lambda: before[0] - tip()[0] > 0.01, 10, "the tool to follow the push along -X")
         finally:
             pose.close()
-        assert "MuJoCo" in _windows(display), "the window closed by itself"
+        assert "MuJoCo" in windows(display), "the window closed by itself"
         h.stop()
         assert h.proc.returncode == 0, h.output()[-3000:]
         assert "escalating" not in h.output(), "a node needed SIGTERM/SIGKILL to stop"

@@ -138,6 +138,12 @@ class MujocoDriverNode:
         self._rtf_pub = publisher("~rtf", Float64)
         self._latency_pub = publisher("~command_latency", Float64MultiArray)
         self._health = DiagnosticsPublisher(self._health_report, self._base_frame)
+        # The push in progress for RViz (compliant_rviz): latched, sent when one starts and, from a 10 Hz
+        # timer off the simulation loop, when it ends.
+        self._push_pub = rospy.Publisher("~active_push", WrenchStamped, queue_size=1, latch=True)
+        self._push_shown: tuple[float, ...] | None = None
+        self._push_lock = threading.Lock()
+        self._push_timer = rospy.Timer(rospy.Duration(0.1), self._show_push)
         self._clock_pub = publisher("/clock", Clock) if s.publish_clock else None
         if self._clock_pub is not None:
             drop_clock_subscription()  # see _publish_clock
@@ -423,6 +429,19 @@ class MujocoDriverNode:
         if frame and frame.lstrip("/") != self._base_frame:
             raise CommandError(f"push wrench frame must be {self._base_frame!r} (or empty), got {frame!r}")
 
+    def _show_push(self, _event: object = None) -> None:
+        """Publishes ~active_push when the push changed (started, replaced or ended)."""
+        wrench = self._sim.push_wrench
+        with self._push_lock:
+            if wrench == self._push_shown:
+                return
+            self._push_shown = wrench
+        msg = WrenchStamped()
+        msg.header.stamp, msg.header.frame_id = rospy.Time.now(), self._base_frame
+        f, t = msg.wrench.force, msg.wrench.torque
+        f.x, f.y, f.z, t.x, t.y, t.z = wrench
+        self._push_pub.publish(msg)
+
     def _on_push_wrench(self, msg: WrenchStamped) -> None:
         f, t = msg.wrench.force, msg.wrench.torque
         with self._lock:
@@ -431,6 +450,8 @@ class MujocoDriverNode:
                 self._sim.push((f.x, f.y, f.z), (t.x, t.y, t.z), duration=self._s.push_timeout)
             except CommandError as exc:
                 self._reject("push_wrench", exc)
+                return
+        self._show_push()
 
     def _on_push(self, req: Any) -> PushEEFResponse:
         f, t = req.wrench.force, req.wrench.torque
@@ -440,6 +461,7 @@ class MujocoDriverNode:
             except CommandError as exc:
                 rospy.logwarn("mujoco_driver: ~push refused: %s", exc)
                 return PushEEFResponse(success=False, message=str(exc))
+        self._show_push()
         message = (f"pushing force [{f.x:g}, {f.y:g}, {f.z:g}] N, torque [{t.x:g}, {t.y:g}, {t.z:g}] Nm "
                    f"({self._base_frame}) for {req.duration:g} s")
         return PushEEFResponse(success=True, message=message)

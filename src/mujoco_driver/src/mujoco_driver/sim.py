@@ -167,6 +167,11 @@ class Simulation:
         """Time left of the current push [s] (0 when none)."""
         return self._push_steps * self.dt
 
+    @property
+    def push_wrench(self) -> tuple[float, ...]:
+        """The current push's force and torque (base frame), zeros when none."""
+        return tuple(float(x) for x in self._push_wrench) if self._push_steps else (0.0,) * 6
+
     def joint_indices(self, names: Sequence[str]) -> np.ndarray:
         """Positions of ``names`` in :attr:`joint_names` (to reorder a message's arrays).
 

@@ -23,6 +23,7 @@ from robot_setup.templates.package_xml import package_xml
 from robot_setup.templates.readme_md import readme_md
 from robot_setup.templates.sim_launch import sim_launch
 from robot_setup.templates.sim_yaml import sim_yaml
+from robot_setup.templates.view_rviz import view_rviz_for
 
 __all__ = ["render"]
 
@@ -40,6 +41,7 @@ def render(plan: Plan, analysis: list[str]) -> dict[str, str]:
         "config/contact_control_hardware.yaml": contact_control_hardware_yaml(plan),
         "config/jog_arm.yaml": jog_arm_yaml(plan),
         "config/jog_arm_hardware.yaml": jog_arm_hardware_yaml(plan),
+        "config/view.rviz": view_rviz_for(plan),
         "launch/sim.launch": sim_launch(plan),
         "launch/hardware.launch": hardware_launch(plan),
         "launch/keyboard.launch": keyboard_launch(plan),

@@ -24,7 +24,7 @@ def hardware_launch(plan: Plan) -> str:
     return _launch_file(
         f"{name}_custom", header, "start robot_state_publisher for this description", "", "", {
             "trajectory_topic": GENERIC_TRAJECTORY_TOPIC,
-        },
+        }, "wrench",
     )
 
 
@@ -69,15 +69,17 @@ def _for_profile(plan: Plan) -> str:
         pkg, header,
         "start robot_state_publisher for this description (false if the driver's launch publishes tf from it)",
         remap, named_poses,
-        {"trajectory_topic": d.trajectory_topic, "joint_states_topic": d.joint_states_topic},
+        {"trajectory_topic": d.trajectory_topic, "joint_states_topic": d.joint_states_topic}, d.wrench_topic,
     )
 
 
 def _launch_file(
-    pkg: str, header: str, state_publisher_doc: str, remap: str, named_poses_comment: str, named_poses: dict[str, str]
+    pkg: str, header: str, state_publisher_doc: str, remap: str, named_poses_comment: str, named_poses: dict[str, str],
+    wrench_topic: str,
 ) -> str:
     """hardware.launch: `header` (comment lines), the stack on the package's hardware YAML, named_poses with
-    the `named_poses` args (a generic driver and a profile's driver differ only in these)."""
+    the `named_poses` args (a generic driver and a profile's driver differ only in these), RViz on the
+    driver's `wrench_topic` with viewer:=rviz."""
     args = "".join(f'\n    <arg name="{key}" value="{value}"/>' for key, value in named_poses.items())
     return f"""<?xml version="1.0"?>
 <!--
@@ -89,6 +91,7 @@ def _launch_file(
   <arg name="with_contact_control" default="true" doc="start contact_control_node"/>
   <arg name="single_process" default="true" doc="contact_control and jog_arm in one process (control_stack_node), as sim.launch; false: two nodes, the twist over a topic"/>
   <arg name="with_named_poses" default="true" doc="start named_poses (move_to a pose of config/named_poses.yaml)"/>
+  <arg name="viewer" default="false" doc="rviz: RViz on config/view.rviz with the stack's markers (needs a DISPLAY)"/>
   <arg name="output" default="screen" doc="screen or log"/>
 {remap}
   <include file="$(find control_stack)/launch/inc/control_stack.launch.xml">
@@ -105,6 +108,12 @@ def _launch_file(
 {named_poses_comment}
   <include if="$(arg with_named_poses)" file="$(find named_poses)/launch/named_poses.launch">
     <arg name="config" value="$(find {pkg})/config/named_poses.yaml"/>{args}
+    <arg name="output" value="$(arg output)"/>
+  </include>
+
+  <include if="$(eval arg('viewer') == 'rviz')" file="$(find compliant_rviz)/launch/view.launch">
+    <arg name="config" value="$(find {pkg})/config/view.rviz"/>
+    <arg name="wrench_topic" value="{wrench_topic}"/>
     <arg name="output" value="$(arg output)"/>
   </include>
 </launch>

@@ -23,6 +23,7 @@ def package_xml(plan: Plan) -> str:
   <license>BSD</license>
 
   <buildtool_depend>catkin</buildtool_depend>
+  <exec_depend>compliant_rviz</exec_depend>
   <exec_depend>contact_control</exec_depend>
   <exec_depend>control_stack</exec_depend>
   <exec_depend>jog_arm</exec_depend>

@@ -17,11 +17,11 @@ def sim_launch(plan: Plan) -> str:
     return f"""<?xml version="1.0"?>
 <!--
   Simulated {name} compliant-control stack ({generated.replace('`', '')}): robot_description,
-  robot_state_publisher, the MuJoCo driver (headless; viewer:=true for a window), jog_arm_server and
+  robot_state_publisher, the MuJoCo driver (headless; viewer:=true for its window, viewer:=rviz for RViz), jog_arm_server and
   contact_control_node, and named_poses. Everything generic is in mujoco_driver/launch/sim_stack.launch.
 -->
 <launch>
-  <arg name="viewer" default="false" doc="open MuJoCo's viewer (only if a DISPLAY exists)"/>
+  <arg name="viewer" default="false" doc="true: MuJoCo's viewer; rviz: RViz on config/view.rviz (both need a DISPLAY)"/>
   <arg name="start_pose" default="" doc="override of config/sim.yaml's start pose: '[q1, ..., qn]' [rad], URDF joint order"/>
   <arg name="real_time_factor" default="1.0" doc="simulated s per wall s; > 1 or 0 (as fast as possible) need sim_time:=true"/>
   <arg name="sim_time" default="false" doc="simulated time: the driver publishes /clock, /use_sim_time true"/>
@@ -38,6 +38,7 @@ def sim_launch(plan: Plan) -> str:
     <arg name="contact_control_config" value="$(find {pkg})/config/contact_control.yaml"/>
     <arg name="trajectory_command_topic" value="{GENERIC_TRAJECTORY_TOPIC}"/>
     <arg name="viewer" value="$(arg viewer)"/>
+    <arg name="rviz_config" value="$(find {pkg})/config/view.rviz"/>
     <arg name="start_pose" value="$(arg start_pose)"/>
     <arg name="real_time_factor" value="$(arg real_time_factor)"/>
     <arg name="sim_time" value="$(arg sim_time)"/>
