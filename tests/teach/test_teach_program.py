@@ -98,6 +98,21 @@ def test_a_recording_becomes_a_program_that_round_trips_through_yaml(tmp_path):
         store.load("l_path")
 
 
+def test_samples_keep_their_poses_times_and_a_pose_seen_again_is_dropped():
+    """The node samples the newest tf at a fixed rate and passes the pose's own stamp: on a busy machine the
+    same pose comes twice or an older one late; kept, they would make the path's speed jump."""
+    rec = Recorder("ur5", "base_link", "tool_tip", 50.0, 0.001, math.radians(1.0))
+    rec.start("stamps", 10.0)
+    stream = ((9.99, 0.0), (10.01, 0.001), (10.01, 0.001), (10.005, 0.0005), (10.03, 0.003), (10.05, 0.005))
+    for t, x in stream:
+        rec.add(t, JOINTS, (0.0, 0.0), (x, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0), (0.0,) * 6)
+    assert rec.count == 4  # the repeated 10.01 and the late 10.005 dropped
+    program = rec.finish()
+    assert program.waypoints[0].t == 0.0  # from the first pose, which was older than the start call
+    assert program.duration == pytest.approx(0.06)
+    assert program.length == pytest.approx(0.005)
+
+
 def test_a_program_of_another_robot_or_joints_is_refused_with_the_reason():
     program = recorded()
     program.check_robot("ur5", JOINTS)

@@ -154,8 +154,11 @@ class TeachNode:
         if wrench is not None:
             f, m = wrench.wrench.force, wrench.wrench.torque
             w = (f.x, f.y, f.z, m.x, m.y, m.z)
+        # The pose's own time, not this timer's: on a busy machine the timer fires late and the newest tf
+        # is older than now, and pairing the two put a replay's speed off by tens of % between waypoints.
+        t = tf.header.stamp.to_sec() or rospy.get_time()
         with self._lock:
-            rec.add(rospy.get_time(), joints.name, joints.position, (p.x, p.y, p.z), (q.x, q.y, q.z, q.w), w)
+            rec.add(t, joints.name, joints.position, (p.x, p.y, p.z), (q.x, q.y, q.z, q.w), w)
             if self._bag is not None:
                 pose = self._pose
                 pose.header.stamp = tf.header.stamp

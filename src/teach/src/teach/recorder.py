@@ -58,7 +58,8 @@ class Recorder:
 
     def add(self, t: float, joint_names: Sequence[str], joints: Sequence[float], position: Sequence[float],
             orientation: Sequence[float], wrench: Sequence[float]) -> None:
-        """One sample (ignored when not recording); the first fixes the joint names."""
+        """One sample at `t`, the pose's own time (ignored when not recording, or when not newer than the
+        last); the first fixes the joint names."""
         if not self.recording or not (_finite(position) and _finite(orientation)):
             return
         names = tuple(joint_names)
@@ -66,11 +67,15 @@ class Recorder:
             self.joint_names = names
         elif names != self.joint_names:
             return  # another joint state layout (a gripper's own message): not this arm's
+        rel = t - self._t0
+        if self._samples and rel <= self._samples[-1][0]:
+            return  # no newer than the last sample (the same pose looked up again): it adds nothing
+        if not self._samples and rel < 0.0:  # the first pose is older than the start call
+            self._t0, rel = t, 0.0
         if self._key_pending:
             self._keys.add(len(self._samples))
             self._key_pending = False
-        self._samples.append(
-            (t - self._t0, tuple(joints), tuple(position), tuple(orientation), tuple(wrench)))
+        self._samples.append((rel, tuple(joints), tuple(position), tuple(orientation), tuple(wrench)))
 
     def keyframe(self) -> int:
         """Marks the next sample as a keyframe; returns the number of keyframes so far.

@@ -44,9 +44,21 @@ same command (the same files come out), check with `make check-robot ROBOT={name
 ```bash
 scripts/with_env roslaunch {pkg} sim.launch            # headless; viewer:=true for a window
 scripts/with_env roslaunch {pkg} sim.launch viewer:=rviz   # RViz on config/view.rviz (compliant_rviz)
-make demo ROBOT={name}                                  # the four thesis demonstrations and surface following
+make demo ROBOT={name}                                  # the six demonstrations
 scripts/with_env rosservice call /named_poses/move_to "{{name: home}}"
 ```
+
+## Look and tune
+
+```bash
+scripts/with_env roslaunch {pkg} sim.launch viewer:=rviz                 # RViz: the robot, wrench, laws, velocity
+scripts/with_env rosrun compliant_common show_diagnostics --detail           # every node's health, worst first
+scripts/with_env rosrun dynamic_reconfigure dynparam get /contact_control_node   # what can change live
+scripts/with_env rosrun dynamic_reconfigure dynparam set /contact_control_node max_velocity 0.05
+scripts/with_env rosrun dynamic_reconfigure dynparam set /jog_arm_server scale/linear 0.2
+```
+(hardware.launch takes viewer:=rviz too; the tunable parameters and how a refused value is answered:
+contact_control's and jog_arm's READMEs.)
 
 ## Files
 
@@ -58,6 +70,7 @@ scripts/with_env rosservice call /named_poses/move_to "{{name: home}}"
 | `config/named_poses.yaml` | `start` (= the scene's start pose) and `home` (the tool lifted) for `/named_poses/move_to` |
 | `config/contact_control.yaml`, `config/jog_arm.yaml` | the stack on top of its defaults: frames (`{plan.base}`), tool mass and COM, thresholds |
 {hardware_row}
+| `config/view.rviz` | RViz's view for viewer:=rviz (compliant_rviz) |
 | `launch/sim.launch`, `launch/keyboard.launch` | the simulated stack; keyboard jogging |
 
 ## Start pose analysis (printed by `make robot`)
