@@ -14,6 +14,7 @@ import pytest
 import yaml
 from harness.display import HAVE_XVFB, NO_XVFB, private_display, screenshot, windows
 from harness.launch import run_launch
+from harness.rviz import named
 from harness.waiting import Collector, wait_until
 
 pytest.importorskip("cartesian_impedance_msgs.srv", reason="needs devel/setup.bash (make test sources it)")
@@ -22,14 +23,6 @@ pytestmark = [pytest.mark.skipif(not HAVE_XVFB, reason=NO_XVFB),
 
 SRC = pathlib.Path(__file__).resolve().parents[2] / "src"
 FIGURE = SRC / "compliant_rviz" / "doc" / "view.png"
-
-
-def _named(array, ns: str):
-    """The marker of namespace `ns` that the array adds (None: absent or deleted)."""
-    for m in array.markers if array is not None else ():
-        if m.ns == ns:
-            return m if m.action == m.ADD else None
-    return None
 
 
 def test_viewer_rviz_shows_the_robot_the_laws_the_velocity_and_the_push(ros_node, tmp_path):
@@ -61,15 +54,15 @@ def test_viewer_rviz_shows_the_robot_the_laws_the_velocity_and_the_push(ros_node
 
                 def idle() -> bool:
                     last = markers.last()
-                    laws = _named(last, "laws")
-                    return _named(last, "obstacle") is not None and laws is not None and "no law" in laws.text
+                    laws = named(last, "laws")
+                    return named(last, "obstacle") is not None and laws is not None and "no law" in laws.text
 
                 wait_until(idle, 20, "the obstacle and 'no law'")
-                box = _named(markers.last(), "obstacle")
+                box = named(markers.last(), "obstacle")
                 p = box.pose.position
                 assert (p.x, p.y, p.z) == pytest.approx(scene["obstacle"]["position"])
                 assert (box.scale.x, box.scale.y, box.scale.z) == pytest.approx(scene["obstacle"]["size"])
-                assert _named(markers.last(), "push") is None and _named(markers.last(), "velocity") is None
+                assert named(markers.last(), "push") is None and named(markers.last(), "velocity") is None
 
                 req = ConfigureForceControlRequest()
                 req.cart_impedance_params.damping.translational.x = 200.0
@@ -82,19 +75,19 @@ def test_viewer_rviz_shows_the_robot_the_laws_the_velocity_and_the_push(ros_node
 
                 def following() -> bool:
                     last = markers.msgs[-3:]
-                    arrows = [_named(a, "velocity") for a in last]
-                    pushes = [_named(a, "push") for a in last]
+                    arrows = [named(a, "velocity") for a in last]
+                    pushes = [named(a, "push") for a in last]
                     return len(last) == 3 and all(arrows) and all(pushes) and all(
                         a.points[1].x < a.points[0].x for a in arrows)  # the velocity along -X
 
                 wait_until(following, 10, "the velocity and push arrows along -X, three times running")
-                text = _named(markers.last(), "laws").text
+                text = named(markers.last(), "laws").text
                 assert text.startswith("x: follower") and "mm/s" in text, text
-                push_arrow = _named(markers.last(), "push")
+                push_arrow = named(markers.last(), "push")
                 assert push_arrow.points[1].x < push_arrow.points[0].x  # drawn pushing toward -X
                 picture = tmp_path / "rviz.png"
                 screenshot(display, str(picture))
-                wait_until(lambda: _named(markers.last(), "push") is None, 10, "no push arrow after the push")
+                wait_until(lambda: named(markers.last(), "push") is None, 10, "no push arrow after the push")
                 h.stop()
         finally:
             markers.close()

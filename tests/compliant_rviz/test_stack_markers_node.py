@@ -5,16 +5,10 @@ from __future__ import annotations
 
 import pytest
 from harness.launch import run_node
+from harness.rviz import named
 from harness.waiting import Collector, wait_until
 
 pytest.importorskip("compliant_control_msgs.msg", reason="needs devel/setup.bash (make test sources it)")
-
-
-def _named(array, ns: str):
-    for m in array.markers if array is not None else ():
-        if m.ns == ns:
-            return m if m.action == m.ADD else None
-    return None
 
 
 def test_a_replay_draws_its_reference_and_the_tools_path(ros_node, tmp_path):
@@ -64,21 +58,21 @@ def test_a_replay_draws_its_reference_and_the_tools_path(ros_node, tmp_path):
                 ref.pose.position.x, ref.pose.position.z = x[0], 0.1
                 ref.pose.orientation.w = 1.0
                 ref_pub.publish(ref)
-                if k > 50 and markers.msgs and _named(markers.last(), "tool path") is not None:
+                if k > 50 and markers.msgs and named(markers.last(), "tool path") is not None:
                     break
                 pace.sleep()
 
             def drawn() -> bool:
                 last = markers.last()
-                return bool(last and _named(last, "reference path") and _named(last, "tool path"))
+                return bool(last and named(last, "reference path") and named(last, "tool path"))
 
             wait_until(drawn, 10, "both paths")
             last = markers.last()
-            reference, tool = _named(last, "reference path"), _named(last, "tool path")
+            reference, tool = named(last, "reference path"), named(last, "tool path")
             assert len(reference.points) >= 2 and len(tool.points) >= 2
             assert all(abs(p.z - 0.1) < 1e-9 for p in reference.points + tool.points)
             assert reference.points[-1].x < reference.points[0].x  # along -X, as sent
-            assert _named(last, "laws").text.startswith("z: force_tracking  +10.1 N  -0.2 mm/s")
-            assert _named(last, "push") is None and _named(last, "obstacle") is None
+            assert named(last, "laws").text.startswith("z: force_tracking  +10.1 N  -0.2 mm/s")
+            assert named(last, "push") is None and named(last, "obstacle") is None
     finally:
         markers.close()
