@@ -58,9 +58,17 @@ def test_the_obstacle_comes_from_the_robot_packages_scene_and_a_bad_one_draws_no
 
 @pytest.mark.parametrize("rpy", [(0.0, 0.0, math.pi / 2), (0.3, -0.7, 2.1)])
 def test_the_box_orientation_follows_urdfs_roll_pitch_yaw(rpy):
+    """URDF: roll about X, then pitch about Y, then yaw about Z (fixed axes): Rz(yaw) Ry(pitch) Rx(roll)."""
+    def about(axis: int, angle: float) -> np.ndarray:
+        c, s = math.cos(angle), math.sin(angle)
+        i, j = [k for k in range(3) if k != axis]
+        r = np.eye(3)
+        r[i, i], r[i, j], r[j, i], r[j, j] = c, -s, s, c
+        return r if axis != 1 else r.T  # about Y the sine's sign is the other way round
+
+    expected = about(2, rpy[2]) @ about(1, rpy[1]) @ about(0, rpy[0])
     x, y, z, w = Box((0, 0, 0), rpy, (1, 1, 1)).quaternion()
-    expected = pin.Quaternion(pin.rpy.rpyToMatrix(*rpy))
-    assert np.allclose(pin.Quaternion(w, x, y, z).matrix(), expected.matrix())
+    assert np.allclose(pin.Quaternion(w, x, y, z).matrix(), expected)
 
 
 def test_a_trail_keeps_points_a_millimetre_apart_and_starts_over_after_a_pause():

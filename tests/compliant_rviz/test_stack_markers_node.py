@@ -11,7 +11,7 @@ from harness.waiting import Collector, wait_until
 pytest.importorskip("compliant_control_msgs.msg", reason="needs devel/setup.bash (make test sources it)")
 
 
-def test_a_replay_draws_its_reference_and_the_tools_path(ros_node, tmp_path):
+def test_a_replay_draws_its_reference_and_the_tools_path(ros_node):
     import tf2_ros
     from compliant_control_msgs.msg import AxisState, ContactControlStatus, PathReference
     from geometry_msgs.msg import TransformStamped, WrenchStamped

@@ -9,12 +9,12 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
 __all__ = ["ARROW_SECONDS", "AxisLine", "Box", "Trail", "axis_text", "obstacle_box", "velocity_arrow"]
 
 ARROW_SECONDS = 2.0  # the velocity arrow is this many seconds of motion long (0.1 m/s: 0.2 m)
 MIN_ARROW = 1e-4  # [m/s] slower than this draws no arrow
-LINEAR, ANGULAR = "m/s", "rad/s"
 
 
 @dataclass(frozen=True)
@@ -70,11 +70,9 @@ class Box:
     size: tuple[float, float, float]
 
     def quaternion(self) -> tuple[float, float, float, float]:
-        """(x, y, z, w) of its roll-pitch-yaw (URDF's convention: about fixed X, then Y, then Z)."""
-        r, p, y = (a / 2.0 for a in self.rpy)
-        cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
-        return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy, cr * cp * sy - sr * sp * cy,
-                cr * cp * cy + sr * sp * sy)
+        """(x, y, z, w) of its roll-pitch-yaw (URDF's convention, Pinocchio's rpyToMatrix)."""
+        x, y, z, w = pin.Quaternion(pin.rpy.rpyToMatrix(*self.rpy)).coeffs()
+        return float(x), float(y), float(z), float(w)
 
 
 def obstacle_box(scene: Mapping[str, object]) -> Box | None:

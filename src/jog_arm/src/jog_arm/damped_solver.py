@@ -79,13 +79,13 @@ class DampedSolver:
         self.q_arr = np.zeros(n)
         self._geom = Geometry()
 
-
     def retune(self, settings: JogSettings) -> None:
         """Live tuning: the singularity thresholds and the pseudo-inverse's damping (from the next cycle)."""
         self._threshold = settings.singularity_threshold
         self._hard_stop = settings.hard_stop_singularity_threshold
         self._damping2 = settings.pinv_damping**2
         self._damping_threshold = settings.pinv_damping_threshold
+
     def start_motion(self, q_arr: FloatArray) -> None:
         """Motion starts at `q_arr`: without a configured posture, the null space pulls back toward it."""
         if not self._posture_fixed:

@@ -298,7 +298,7 @@ class JogSettings:
             if key not in TUNABLE:
                 raise SettingsError(f"{prefix}{key} cannot be tuned live (tunable: {', '.join(TUNABLE)})")
         try:
-            values = PARAMETERS.convert({k: v for k, v in changed.items()})
+            values = PARAMETERS.convert(changed)
         except SchemaError as err:
             raise SettingsError(_message(prefix, err)) from None
         settings = PARAMETERS.build(JogSettings, {**PARAMETERS.values_of(self), **values})
