@@ -12,6 +12,7 @@ import threading
 import rospy
 import tf2_ros
 import yaml
+from compliant_common.ros_time import timer
 from compliant_control_msgs.msg import ContactControlStatus, PathReference
 from geometry_msgs.msg import Point, WrenchStamped
 from std_msgs.msg import ColorRGBA
@@ -55,7 +56,7 @@ class StackMarkers:
             rospy.Subscriber(rospy.get_param("~push_topic", "/mujoco_driver/active_push"), WrenchStamped,
                              self._on_push, queue_size=1),
         ]
-        self._timer = rospy.Timer(rospy.Duration(1.0 / float(rospy.get_param("~rate", 10.0))), self._tick)
+        self._timer = timer(1.0 / float(rospy.get_param("~rate", 10.0)), self._tick)
 
     @staticmethod
     def _scene_box(path: str) -> Box | None:

@@ -23,6 +23,7 @@ import rospy
 from compliant_common.diagnostics import Report
 from compliant_common.master import MasterWatch
 from compliant_common.ros_diagnostics import DiagnosticsPublisher
+from compliant_common.ros_time import timer
 from compliant_common.rospy_internals import drop_clock_subscription, set_rostime
 from compliant_common.runtime import tune_runtime
 from compliant_control_msgs.srv import PushEEF, PushEEFResponse
@@ -143,7 +144,7 @@ class MujocoDriverNode:
         self._push_pub = rospy.Publisher("~active_push", WrenchStamped, queue_size=1, latch=True)
         self._push_shown: tuple[float, ...] | None = None
         self._push_lock = threading.Lock()
-        self._push_timer = rospy.Timer(rospy.Duration(0.1), self._show_push)
+        self._push_timer = timer(0.1, self._show_push)
         self._clock_pub = publisher("/clock", Clock) if s.publish_clock else None
         if self._clock_pub is not None:
             drop_clock_subscription()  # see _publish_clock
