@@ -37,11 +37,13 @@ demo: build
 		$(if $(HARDWARE_ARGS),--hardware-args "$(HARDWARE_ARGS)") $(if $(BAG),--bag)
 
 # make robot NAME=<name> URDF=<path, or relative to example-robot-data's robots/> TIP=<flange link>
-#   [BASE=<link>] [TOOL_MASS=<kg>] [DRIVER=<mujoco_driver profile name or YAML path>]: writes
-#   src/<name>_custom/ (hardware files for that driver; none: a generic ros_control driver) and checks it.
+#   [BASE=<link>] [TOOL_MASS=<kg>] [TOOL_RPY=<roll,pitch,yaw>] [HELD=<joint=position,...>]
+#   [DRIVER=<mujoco_driver profile name or YAML path>]: writes src/<name>_custom/ (hardware files for that
+#   driver; none: a generic ros_control driver) and checks it. robot_setup's README: Add an arm.
 robot: build
 	@$(ENV) python -m robot_setup.generate --name "$(NAME)" --urdf "$(URDF)" --tip "$(TIP)" \
 		$(if $(BASE),--base "$(BASE)") $(if $(TOOL_MASS),--tool-mass "$(TOOL_MASS)") \
+		$(if $(TOOL_RPY),--tool-rpy="$(TOOL_RPY)") $(if $(HELD),--held "$(HELD)") \
 		$(if $(DRIVER),--driver "$(DRIVER)") --src src
 	@scripts/bootstrap >/dev/null
 

@@ -21,9 +21,10 @@ def _dynparam(*args: str) -> subprocess.CompletedProcess:
 def test_a_lower_speed_clamp_slows_the_moving_tool_without_a_step_and_a_bad_value_is_refused(ros_node):
     rospy = ros_node
     from compliant_control_msgs.srv import Guide, PushEEF, PushEEFRequest
+    from geometry_msgs.msg import TwistStamped
     from harness.launch import run_launch
     from harness.observed import SimArm
-    from harness.waiting import wait_until
+    from harness.waiting import Collector, wait_until
 
     with run_launch("ur5_custom", "sim.launch") as h:
         h.wait_for_service("/contact_control_node/set_parameters", timeout=40)
@@ -42,16 +43,22 @@ def test_a_lower_speed_clamp_slows_the_moving_tool_without_a_step_and_a_bad_valu
                 return (x1 - x0) / (t1 - t0) if t1 > t0 else 0.0
 
             wait_until(lambda: speed() > 0.15, 10, "the guided tool at about 0.2 m/s")
-            arm.status.clear()
-            tuned = _dynparam("set", "/contact_control_node", "max_velocity", "0.05")
-            assert tuned.returncode == 0, tuned.stderr
-            wait_until(lambda: speed() < 0.055, 10, "the tool slowed to the new clamp")
-            commanded = np.array([(m.header.stamp.to_sec(), m.velocity.linear.x) for m in arm.status.msgs])
+            # The twists themselves, stamped with the time of the wrench each answers (the status timer's
+            # stamps are its own: on a busy machine a late status made a step look steeper than it was).
+            twists = Collector("/jog_arm_server/contact_cmds", TwistStamped)
+            try:
+                twists.wait_for(10, timeout=10)
+                tuned = _dynparam("set", "/contact_control_node", "max_velocity", "0.05")
+                assert tuned.returncode == 0, tuned.stderr
+                wait_until(lambda: speed() < 0.055, 10, "the tool slowed to the new clamp")
+            finally:
+                twists.close()
+            commanded = np.array([(m.header.stamp.to_sec(), m.twist.linear.x) for m in twists.msgs])
             slowing = -np.diff(commanded[:, 1]) / np.maximum(np.diff(commanded[:, 0]), 1e-3)
             print(f"\ncommanded {commanded[0, 1]:.3f} -> {commanded[-1, 1]:.3f} m/s, fastest slowing "
                   f"{slowing.max():.2f} m/s^2 (deceleration_linear 2.5)")
             assert commanded[:, 1].max() > 0.15 and commanded[-1, 1] <= 0.0501
-            assert slowing.max() <= 2.5 * 1.2, slowing.max()  # bumpless: within the deceleration limit
+            assert slowing.max() <= 2.5 * 1.02, slowing.max()  # bumpless: within the deceleration limit
 
             refused = _dynparam("set", "/contact_control_node", "max_velocity", "-1")
             assert refused.returncode == 0

@@ -60,12 +60,22 @@ def test_fork_yaml_layout_is_read() -> None:
         ({"joint_limits": {"j1": {"max_velocity": -1.0}}}, "joint_limits/j1/max_velocity"),
         ({"joint_limits": {"j1": {"max_jerk": 1.0}}}, "joint_limits/j1"),
         ({"ee_frame_name": ""}, "ee_frame_name"),
+        ({"held_joints": [{"head_1_joint": "up"}]}, "held_joints/head_1_joint"),
+        ({"held_joints": ["head_1_joint"]}, "held_joints"),
     ],
     ids=lambda v: v if isinstance(v, str) else None,
 )
 def test_bad_settings_refused_naming_the_key(params: dict, key: str) -> None:
     with pytest.raises(SettingsError, match=re.escape(f"jog_arm_server/{key}")):
         JogSettings.from_params(params)
+
+
+def test_held_joints_are_a_list_a_later_robot_file_replaces() -> None:
+    """`held_joints` is a list of `<joint>: position` (a mapping loaded over another robot's would merge with
+    it on the parameter server); jog_arm's own file says `[]`."""
+    held = JogSettings.from_params({"held_joints": [{"torso_lift_joint": 0.1}, {"head_1_joint": 0}]})
+    assert held.held_joints == {"torso_lift_joint": 0.1, "head_1_joint": 0.0}
+    assert JogSettings.from_params({}).held_joints == {}
 
 
 def test_renamed_keys_warn_and_unknown_keys_refuse_start_up() -> None:

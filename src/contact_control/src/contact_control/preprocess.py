@@ -2,7 +2,8 @@
 frame change and deadband, in that order.
 
 Convention: the result is the external wrench acting on the end effector, as a human pushing it feels it
-(push the tool along +Z and F_z > 0), in the control frame, torque about the control frame origin.
+(push the tool along +Z and F_z > 0), in the control frame's axes, torque about the origin `T_control_sensor`
+is relative to (the node passes the end effector's position with the control frame's axes).
 The sensor is assumed to read the tool's weight as m * g (g = `gravity` in the fixed frame) plus the external
 wrench plus a constant offset. Rotations and transforms are row-major nested sequences or numpy arrays:
 `R_world_sensor` maps sensor-frame vectors into the fixed frame, `T_control_sensor` (4x4) maps sensor-frame
@@ -252,7 +253,7 @@ class WrenchPreprocessor:
             cfx = r0[0] * fx + r0[1] * fy + r0[2] * fz
             cfy = r1[0] * fx + r1[1] * fy + r1[2] * fz
             cfz = r2[0] * fx + r2[1] * fy + r2[2] * fz
-            # Torque about the control origin: rotated sensor torque plus lever arm p x F.
+            # Torque about the reference origin: rotated sensor torque plus lever arm p x F.
             tx, ty, tz = (
                 r0[0] * tx + r0[1] * ty + r0[2] * tz + py * cfz - pz * cfy,
                 r1[0] * tx + r1[1] * ty + r1[2] * tz + pz * cfx - px * cfz,

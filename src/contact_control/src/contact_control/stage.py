@@ -136,12 +136,13 @@ class ContactStage:
         T_fixed_control = self._pose(s.control_frame)
         R_fixed_control = None if s.control_frame == s.fixed_frame else rotation(T_fixed_control)
         T_control_sensor = None
-        if sensor_frame != s.control_frame:
-            T_fixed_sensor = self._pose(sensor_frame)
-            if R_fixed_control is None:
-                T_control_sensor = T_fixed_sensor
-            else:
-                T_control_sensor = compose(inverse(T_fixed_control), T_fixed_sensor)
+        if sensor_frame != s.control_frame or sensor_frame != s.eef_frame:
+            # Axes: the control frame's; reference point: the end effector, which the twist moves (a push on
+            # the tool is no torque there, wherever the control frame's origin is: README, Preprocessing).
+            T_fixed_sensor, T_fixed_eef = self._pose(sensor_frame), self._pose(s.eef_frame)
+            rows = zip(T_fixed_control[:3], T_fixed_eef[:3], strict=True)
+            T_fixed_ref = [*([*row[:3], eef_row[3]] for row, eef_row in rows), IDENTITY[3]]
+            T_control_sensor = compose(inverse(T_fixed_ref), T_fixed_sensor)
         R_world_sensor = rotation(self._pose(sensor_frame)) if self._gravity else None
         eef = self._pose(s.eef_frame) if self.ctrl.needs_travel else None
         R_command_control = None

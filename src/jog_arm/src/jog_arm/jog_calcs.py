@@ -117,6 +117,7 @@ class JogCalcs:
             settings.joint_names,
             settings.joint_limits,
             settings.default_max_acceleration,
+            settings.held_joints,
         )
         if not self.model.has_frame(settings.planning_frame):
             raise KinematicsError(

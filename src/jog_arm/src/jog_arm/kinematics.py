@@ -1,7 +1,8 @@
 """Serial-arm kinematics from a URDF string with Pinocchio: EEF pose and Jacobian of the controlled joints.
 
-Joints that are not controlled (grippers, a mobile base, ...) are locked at their neutral position with
-``pinocchio.buildReducedModel``, so the Jacobian has exactly one column per controlled joint. The model
+Joints that are not controlled (grippers, a head, another arm, a mobile base, ...) are locked with
+``pinocchio.buildReducedModel`` at their held position (``held_positions``; 0 clamped into the joint's limits
+for the others), so the Jacobian has exactly one column per controlled joint. The model
 and its data are built once; every query reuses them.
 
 Frames: Jacobians are ``LOCAL_WORLD_ALIGNED`` at the tip frame, i.e. the velocity of the tip's origin and
@@ -45,10 +46,13 @@ class ArmModel:
             value per joint (continuous joints included: see the module docstring).
         joint_limits: Per-joint overrides of the URDF limits.
         default_max_acceleration: Acceleration limit [rad/s²] of joints without an override.
+        held_positions: Where joints that are not controlled are locked [rad or m]; absent ones at 0 clamped
+            into their limits.
 
     Raises:
-        KinematicsError: Unparsable URDF, unknown frame or joint, a joint that is not a 1-DoF joint, or
-            a joint without a velocity limit (continuous joints often lack one: set it in the YAML).
+        KinematicsError: Unparsable URDF, unknown frame or joint, a joint that is not a 1-DoF joint, a
+            joint both controlled and held, or a joint without a velocity limit (continuous joints often
+            lack one: set it in the YAML).
 
     Attributes:
         continuous: Per joint (model order), True for a continuous joint. Its `lower` / `upper` are
@@ -62,6 +66,7 @@ class ArmModel:
         joint_names: Sequence[str] = (),
         joint_limits: Mapping[str, JointLimitOverride] | None = None,
         default_max_acceleration: float = 3.0,
+        held_positions: Mapping[str, float] | None = None,
     ) -> None:
         try:
             full = pin.buildModelFromXML(urdf_xml)
@@ -82,7 +87,8 @@ class ArmModel:
                     f"(nq={joint.nq}, nv={joint.nv})"
                 )
         locked = [jid for jid in range(1, full.njoints) if full.names[jid] not in controlled]
-        model = pin.buildReducedModel(full, locked, pin.neutral(full)) if locked else full
+        held = _held_configuration(full, controlled, held_positions or {})
+        model = pin.buildReducedModel(full, locked, held) if locked else full
         self.model = model
         self.data = model.createData()
         self._pose_data = model.createData()  # for measured_pose, so it never disturbs a cycle's data
@@ -273,6 +279,29 @@ def _chain_joints(model: pin.Model, tip_frame: str) -> list[str]:
     """Names of the joints from the root to `tip_frame` (checked for 1 DoF by the caller)."""
     parent = model.frames[model.getFrameId(tip_frame)].parentJoint
     return [model.names[jid] for jid in model.supports[parent][1:]]
+
+
+def _held_configuration(full: pin.Model, controlled: Sequence[str], held: Mapping[str, float]) -> FloatArray:
+    """Pinocchio's q of the full model with every joint that is not controlled at its held position."""
+    q = pin.neutral(full)
+    for name, value in held.items():
+        if not full.existJointName(name):
+            raise KinematicsError(f"held_joints: {name!r} is not a joint of the URDF")
+        if name in controlled:
+            raise KinematicsError(f"held_joints: {name!r} is a controlled joint (joint_names)")
+        if not math.isfinite(float(value)):
+            raise KinematicsError(f"held_joints: {name} must be a finite number, got {value!r}")
+    for jid in range(1, full.njoints):
+        name, joint = full.names[jid], full.joints[jid]
+        if name in controlled or joint.nv != 1:
+            continue
+        value = float(held.get(name, 0.0))
+        if joint.nq == 2:  # continuous: (cos, sin)
+            q[joint.idx_q : joint.idx_q + 2] = (math.cos(value), math.sin(value))
+        else:
+            lo, hi = full.lowerPositionLimit[joint.idx_q], full.upperPositionLimit[joint.idx_q]
+            q[joint.idx_q] = min(max(value, lo), hi) if name not in held else value
+    return np.asarray(q, dtype=float)
 
 
 def _frame_names(model: pin.Model) -> list[str]:

@@ -24,6 +24,7 @@ __all__ = [
     "JointLimitOverride",
     "SettingsError",
     "flatten_params",
+    "held_positions",
 ]
 
 COMMAND_IN_TYPES = ("unitless", "speed_units")
@@ -141,7 +142,13 @@ class JogSettings:
     joint_names: tuple[str, ...] = param(
         (), type="strings", shown_range="no duplicates",
         doc="controlled joints in output order; `[]` = all joints from the root to `ee_frame_name`; others "
-        "are locked at 0",
+        "are locked (`held_joints`)",
+    )
+    held_joints: Mapping[str, float] = param(
+        {}, type="any", unit="rad, m", shown_default="[]",
+        doc="`[<joint>: position, ...]` of joints jog_arm never moves (a gripper, a head, another arm); "
+        "joints neither controlled nor listed are held at 0 clamped into their limits. A list, so that "
+        "loading a robot's file replaces an earlier robot's on the master",
     )
     command_in_type: str = param(
         "unitless", choices=COMMAND_IN_TYPES, doc="speed_units: m/s and rad/s, as contact_control sends"
@@ -241,7 +248,7 @@ class JogSettings:
         given: dict[str, object] = {}
         for key in sorted(flat):
             base = key.split("/")[0]
-            if key in PARAMETERS or key in _NODE_ONLY or key.startswith("joint_limits/"):
+            if key in PARAMETERS or key in _NODE_ONLY or key.startswith(_NESTED):
                 given[key] = flat[key]
             elif key in _RENAMED or base in _RENAMED:
                 new = _RENAMED.get(key, _RENAMED.get(base))
@@ -249,12 +256,13 @@ class JogSettings:
                 warnings.append(f"{prefix}{key} is a renamed or unsupported key: {hint}")
             else:
                 given[key] = flat[key]
-        scalars = {k: v for k, v in given.items() if not k.startswith("joint_limits/")}
+        scalars = {k: v for k, v in given.items() if not k.startswith(_NESTED)}
         try:
             values = PARAMETERS.load(scalars, prefix, also_known=_NODE_ONLY)
         except SchemaError as err:
             raise SettingsError(_message(prefix, err)) from None
         values["joint_limits"] = _read_joint_limits(given, prefix)
+        values["held_joints"] = held_positions(values.get("held_joints", []), f"{prefix}held_joints")
         settings = PARAMETERS.build(cls, values)
         settings.validate(prefix)
         return settings, warnings
@@ -330,19 +338,42 @@ def _message(prefix: str, err: SchemaError) -> str:
     return f"{prefix}{err.key}: {err.message}"
 
 
+# Per-joint mappings: flattened to "<key>/<joint>" and no further (a joint's limits stay one mapping).
+_NESTED = ("joint_limits/",)
+
+
 def flatten_params(params: ParamMap, base: str = "") -> dict[str, object]:
     """Flattens nested parameter dictionaries into "a/b" keys (flat keys pass through)."""
     flat: dict[str, object] = {}
     for key, value in params.items():
         name = f"{base}{str(key).strip('/')}"
-        if isinstance(value, Mapping) and name != "joint_limits" and not name.startswith("joint_limits/"):
+        if isinstance(value, Mapping) and f"{name}/" in _NESTED:
+            for joint, entry in value.items():
+                flat[f"{name}/{joint}"] = entry
+        elif isinstance(value, Mapping) and not name.startswith(_NESTED):
             flat.update(flatten_params(value, name + "/"))
-        elif isinstance(value, Mapping) and name == "joint_limits":
-            for joint, limits in value.items():
-                flat[f"joint_limits/{joint}"] = limits
         else:
             flat[name] = value
     return flat
+
+
+def held_positions(value: object, key: str) -> dict[str, float]:
+    """`held_joints` as written in YAML, a list of `<joint>: position` entries (a mapping is taken too).
+
+    Raises:
+        SettingsError: Not such a list, or a position that is not a finite number; the message names `key`.
+    """
+    entries = [value] if isinstance(value, Mapping) else value
+    if not isinstance(entries, list | tuple) or not all(isinstance(e, Mapping) for e in entries):
+        raise SettingsError(f"{key} must be a list of <joint>: position entries, got {value!r}")
+    held: dict[str, float] = {}
+    for entry in entries:
+        for name, position in entry.items():
+            number = isinstance(position, int | float) and not isinstance(position, bool)
+            if not number or not math.isfinite(position):
+                raise SettingsError(f"{key}/{name} must be a finite position [rad or m], got {position!r}")
+            held[str(name)] = float(position)
+    return held
 
 
 def _read_joint_limits(flat: ParamMap, prefix: str) -> dict[str, JointLimitOverride]:

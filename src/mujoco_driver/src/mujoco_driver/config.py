@@ -180,7 +180,13 @@ class NoiseConfig:
 
 @dataclass(frozen=True)
 class SceneConfig:
-    """Everything robot-specific about the simulated scene except the URDF."""
+    """Everything robot-specific about the simulated scene except the URDF.
+
+    ``held_joints`` (joint name -> position; in YAML a list of ``<joint>: position``, as jog_arm's) are the
+    joints outside the arm's chain (a gripper, a head,
+    another arm): their servos hold them there, velocity commands leave them out, ``start_pose`` does not
+    list them. Every other movable joint is an arm joint.
+    """
 
     start_pose: PerJoint
     servo: ServoConfig
@@ -190,6 +196,7 @@ class SceneConfig:
     table: TableConfig = field(default_factory=TableConfig)
     obstacle: Box | None = None
     wrench_noise: NoiseConfig = field(default_factory=NoiseConfig)
+    held_joints: Mapping[str, float] = field(default_factory=dict)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> SceneConfig:
@@ -201,7 +208,8 @@ class SceneConfig:
         if not isinstance(data, Mapping):
             raise ConfigError(f"scene config must be a mapping, got {type(data).__name__}")
         known = (
-            "timestep", "integrator", "links", "table", "obstacle", "start_pose", "servo", "wrench_noise"
+            "timestep", "integrator", "links", "table", "obstacle", "start_pose", "servo", "wrench_noise",
+            "held_joints",
         )
         unknown = set(data) - set(known)
         if unknown:
@@ -246,7 +254,12 @@ class SceneConfig:
         seed = noise.get("seed")
         if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int)):
             raise ConfigError(f"wrench_noise.seed: expected an integer, got {seed!r}")
+        held = data.get("held_joints") or []
+        entries = [held] if isinstance(held, Mapping) else held
+        if not isinstance(entries, list) or not all(isinstance(e, Mapping) for e in entries):
+            raise ConfigError(f"held_joints: expected a list of <joint>: position entries, got {held!r}")
         return cls(
+            held_joints={str(k): _number(v, f"held_joints.{k}") for e in entries for k, v in e.items()},
             start_pose=PerJoint.parse(data["start_pose"], "start_pose"),
             servo=ServoConfig(
                 kp=PerJoint.parse(servo["kp"], "servo.kp", 0.0, strict_low=True),

@@ -39,7 +39,7 @@ class DriverEmulation:
             raise ProfileError(f"driver profile {profile.driver}: links {missing} are not in the robot "
                                "description")
         self._body = {name: model.body(name).id for name in profile.links()}
-        self.controllers = ControllerManager(profile.controllers, sim.joint_names)
+        self.controllers = ControllerManager(profile.controllers, sim.arm_joint_names)
         self.model = WrenchModel(profile.wrench, len(sim.joint_names), 1.0 / profile.publish_rate)
         self.reflex = Reflex(profile.reflex.force_thresholds) if profile.reflex else None
         self.wrench = np.zeros(6)  # what the driver publishes [N, Nm]

@@ -419,7 +419,7 @@ class MujocoDriverNode:
                 return
             sim = self._sim
             try:
-                sim.set_velocity_targets(velocity_vector(msg.data, sim.joint_names))
+                sim.set_arm_velocity_targets(velocity_vector(msg.data, sim.arm_joint_names))
             except CommandError as exc:
                 self._reject("velocity command", exc)
                 return

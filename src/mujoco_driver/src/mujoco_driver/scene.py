@@ -149,6 +149,8 @@ def mujoco_urdf_report(urdf_xml: str, mesh_cache: str | None = None) -> tuple[st
             if not os.path.isfile(path):
                 raise SceneError(f"collision mesh {path} does not exist")
             mesh.set("filename", path)
+    for link in robot.findall("link"):
+        _sane_inertia(link)
     report = prepare_collision(robot, mesh_cache)
     for link in robot.findall("link"):
         for visual in link.findall("visual"):
@@ -159,6 +161,28 @@ def mujoco_urdf_report(urdf_xml: str, mesh_cache: str | None = None) -> tuple[st
     ET.SubElement(extension, "compiler", fusestatic="false", discardvisual="true", strippath="false",
                   balanceinertia="true")
     return ET.tostring(robot, encoding="unicode"), report
+
+
+def _sane_inertia(link: ET.Element) -> None:
+    """A link whose inertia matrix is not positive definite (TIAGo's antenna links: products larger than the
+    moments) keeps only its moments: MuJoCo refuses to compile such a body; for a link that light or small the
+    difference does not matter."""
+    inertia = link.find("inertial/inertia")
+    if inertia is None:
+        return
+    try:
+        v = {k: float(inertia.get(k, "0")) for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+    except ValueError:
+        return
+    matrix = np.array([[v["ixx"], v["ixy"], v["ixz"]], [v["ixy"], v["iyy"], v["iyz"]],
+                       [v["ixz"], v["iyz"], v["izz"]]])
+    if np.all(np.linalg.eigvalsh(matrix) > 0.0):
+        return
+    _log.info("link %s: inertia not positive definite, its products of inertia dropped", link.get("name"))
+    for key in ("ixy", "ixz", "iyz"):
+        inertia.set(key, "0")
+    for key in ("ixx", "iyy", "izz"):
+        inertia.set(key, repr(max(abs(v[key]), 1e-9)))
 
 
 def _local_path(uri: str) -> str | None:
@@ -174,6 +198,7 @@ class SceneModel:
     Attributes:
         model: The compiled MjModel.
         joint_names: Movable joints, in model (and URDF tree) order.
+        arm_index: Positions in `joint_names` of the arm's joints (all but the held ones), in that order.
         qpos_adr: qpos address of each joint.
         dof_adr: qvel address of each joint.
         ctrl_adr: ctrl address of each joint's servo: [adr] position, [adr+1] velocity, [adr+2] torque.
@@ -194,6 +219,7 @@ class SceneModel:
 
     model: mujoco.MjModel
     joint_names: list[str]
+    arm_index: np.ndarray
     qpos_adr: np.ndarray
     dof_adr: np.ndarray
     ctrl_adr: np.ndarray
@@ -244,6 +270,43 @@ def _add_environment(spec: mujoco.MjSpec, cfg: SceneConfig) -> None:
         geom.solimp = OBSTACLE_SOLIMP
 
 
+OVERLAP_SAMPLES = 8  # postures (the start pose and fixed pseudo-random ones) a pair must touch in all of
+
+
+def _overlapping_links(
+    model: mujoco.MjModel, names: Sequence[str], arm_names: Sequence[str], start: np.ndarray,
+    measured: set[str],
+) -> list[tuple[str, str]]:
+    """Pairs of the robot's links (not the tool's) that penetrate in every one of OVERLAP_SAMPLES postures
+    of the arm: a link's mesh reaching into its mount or a neighbour (TIAGo's first arm link in its torso
+    column, its wrist links), which MuJoCo would push apart from the first step."""
+    data = mujoco.MjData(model)
+    adr = {n: int(model.jnt_qposadr[model.joint(n).id]) for n in names}
+    for name, value in zip(names, start, strict=True):
+        data.qpos[adr[name]] = value
+    rng = np.random.default_rng(0)
+    always: set[tuple[int, int]] | None = None
+    for k in range(OVERLAP_SAMPLES):
+        if k:
+            for name in arm_names:
+                jid = model.joint(name).id
+                lo, hi = model.jnt_range[jid] if model.jnt_limited[jid] else (-math.pi, math.pi)
+                data.qpos[adr[name]] = lo + (hi - lo) * rng.random()
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_collision(model, data)
+        pairs = set()
+        for i in range(data.ncon):
+            con = data.contact[i]
+            a, b = sorted((int(model.geom_bodyid[con.geom1]), int(model.geom_bodyid[con.geom2])))
+            if con.dist < 0.0 and a > 0:  # body 0 (world): the table, floor and obstacle
+                pairs.add((a, b))
+        always = pairs if always is None else always & pairs
+        if not always:
+            return []
+    body = lambda i: mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, i)  # noqa: E731
+    return sorted((body(a), body(b)) for a, b in always or set() if not {body(a), body(b)} & measured)
+
+
 def build_scene(urdf_xml: str, cfg: SceneConfig, mesh_cache: str | None = None) -> SceneModel:
     """Compile the scene.
 
@@ -287,6 +350,10 @@ def build_scene(urdf_xml: str, cfg: SceneConfig, mesh_cache: str | None = None) 
 
     joints = [j for j in spec.joints]
     names = [j.name for j in joints]
+    unknown = [n for n in cfg.held_joints if n not in names]
+    if unknown:
+        raise SceneError(f"held_joints: {unknown} are not movable joints of the URDF {names}")
+    arm_names = [n for n in names if n not in cfg.held_joints]
     for joint in joints:
         if joint.type not in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE):
             raise SceneError(f"joint {joint.name}: only revolute/prismatic joints are supported")
@@ -296,10 +363,13 @@ def build_scene(urdf_xml: str, cfg: SceneConfig, mesh_cache: str | None = None) 
         kp = cfg.servo.kp.resolve(names)
         kv = cfg.servo.kv.resolve(names)
         armature = cfg.servo.armature.resolve(names)
-        start = np.array(cfg.start_pose.resolve(names))
+        arm_start = dict(zip(arm_names, cfg.start_pose.resolve(arm_names), strict=True))
+        start = np.array([arm_start[n] if n in arm_start else cfg.held_joints[n] for n in names])
         max_acceleration = np.array(cfg.servo.max_acceleration.resolve(names))
     except ValueError as exc:
-        raise SceneError(str(exc)) from exc
+        held = (f" (held joints: {sorted(cfg.held_joints)})" if cfg.held_joints else
+                " (joints outside the arm go in held_joints: name -> position)")
+        raise SceneError(f"{exc}{held}") from exc
 
     for body in spec.bodies:
         if body.name != "world":
@@ -326,6 +396,13 @@ def build_scene(urdf_xml: str, cfg: SceneConfig, mesh_cache: str | None = None) 
     _add_environment(spec, cfg)
     try:
         model = spec.compile()
+        overlaps = _overlapping_links(model, names, arm_names, start, measured)
+        if overlaps:  # meshes that overlap by design would push the arm from its start: not contacts
+            _log.info("links whose meshes overlap in every posture, not collided: %s",
+                      ", ".join(f"{a} / {b}" for a, b in overlaps))
+            for a, b in overlaps:
+                spec.add_exclude(bodyname1=a, bodyname2=b)
+            model = spec.compile()
     except ValueError as exc:
         raise SceneError(f"MuJoCo cannot compile the scene: {exc}") from exc
 
@@ -335,11 +412,12 @@ def build_scene(urdf_xml: str, cfg: SceneConfig, mesh_cache: str | None = None) 
     vel = [limits[n].velocity if n in limits and limits[n].velocity else np.inf for n in names]
     outside = [n for n, q, lo, hi in zip(names, start, lower, upper, strict=True) if not lo <= q <= hi]
     if outside:
-        raise SceneError(f"start_pose: joints {outside} outside their limits")
+        raise SceneError(f"start_pose / held_joints: joints {outside} outside their limits")
     sensor_id = model.body(cfg.links.ft_sensor).id
     return SceneModel(
         model=model,
         joint_names=names,
+        arm_index=np.array([names.index(n) for n in arm_names], dtype=np.intp),
         qpos_adr=np.array([model.jnt_qposadr[j] for j in jids]),
         dof_adr=np.array([model.jnt_dofadr[j] for j in jids]),
         ctrl_adr=np.array([model.actuator_ctrladr[model.actuator(f"{n}_servo").id] for n in names]),

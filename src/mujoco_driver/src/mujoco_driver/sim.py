@@ -82,7 +82,10 @@ class Simulation:
         self.model = self.scene.model
         self.data = mujoco.MjData(self.model)
         self.joint_names: tuple[str, ...] = tuple(self.scene.joint_names)
+        # The joints velocity commands address (every joint but the held ones), in joint_names order.
+        self.arm_joint_names: tuple[str, ...] = tuple(self.joint_names[i] for i in self.scene.arm_index)
         n = len(self.joint_names)
+        self._arm_qd = np.zeros(n)  # a velocity command of the arm joints, held joints at 0
         self._dt = float(self.model.opt.timestep)
         self._index = {name: i for i, name in enumerate(self.joint_names)}
         sc = self.scene
@@ -271,6 +274,21 @@ class Simulation:
             qd = qd / ratio
         self._qd_command[:] = qd
         self._mode, self._traj = MODE_VELOCITY, None
+
+    def set_arm_velocity_targets(self, qd: np.ndarray) -> None:
+        """:meth:`set_velocity_targets` for the arm joints (``arm_joint_names`` order); held joints stay.
+
+        Raises:
+            CommandError: On a wrong length or non-finite values.
+        """
+        if len(self.arm_joint_names) == len(self.joint_names):
+            self.set_velocity_targets(qd)
+            return
+        if np.shape(qd) != (len(self.arm_joint_names),):
+            raise CommandError(f"velocity targets: expected {len(self.arm_joint_names)} values (arm joints "
+                               f"{list(self.arm_joint_names)}), got shape {np.shape(qd)}")
+        self._arm_qd[self.scene.arm_index] = qd
+        self.set_velocity_targets(self._arm_qd)
 
     def set_trajectory(self, points: Sequence[TrajectoryPoint], start_time: float | None = None) -> None:
         """Follow ``points`` from the current setpoint, starting at ``start_time`` (default: now).

@@ -36,12 +36,16 @@ __all__ = [
     "margins",
     "solve_ik",
     "tip_path",
+    "tool_down_heights",
 ]
 
 # Tool pointing down: sensor x = +X, y = -Y, z = -Z of the base frame (the hand-written start poses).
 DOWN = np.diag([1.0, -1.0, -1.0])
 LENGTH_SCALE = JogSettings.singularity_length_scale  # [m] jog_arm's default
 IK_TOLERANCE = 1e-6  # [m, rad] a pose counts as reached below this error
+# solve_ik gives up when STALL_ITERATIONS iterations left the error above STALL_ERROR and above STALL_RATIO of
+# what it was (generating the UR3's and the Jaco2's packages gives the same files with and without this).
+STALL_ITERATIONS, STALL_RATIO, STALL_ERROR = 25, 0.9, 1e-3
 PATH_STEPS = 20
 # A start pose is refused closer than this to a joint limit anywhere on the demos' motions [rad].
 MIN_MARGIN = 0.15
@@ -91,13 +95,20 @@ def solve_ik(
     """
     q = np.array(seed, dtype=float)
     lo, hi = arm.lower + limit_margin, arm.upper - limit_margin
-    for _ in range(iterations):
+    earlier = math.inf
+    for i in range(iterations):
         jac = arm.jacobian(q)  # also places the tip frame: one kinematics pass per iteration
         tip = arm.data.oMf[arm.tip_id]
         err = np.concatenate([goal.translation - tip.translation, pin.log3(goal.rotation @ tip.rotation.T)])
         norm = float(np.linalg.norm(err))
         if norm < IK_TOLERANCE:
             return q
+        if i % STALL_ITERATIONS == 0:
+            # Stuck (against a limit, or at a goal out of reach): a converging solve gains far more than
+            # this in STALL_ITERATIONS; most of the start pose search's time went on such hopeless seeds.
+            if norm > STALL_RATIO * earlier and norm > STALL_ERROR:
+                return None
+            earlier = norm
         damping = 1e-6 + 1e-3 * min(1.0, norm)
         step = jac.T @ np.linalg.solve(jac @ jac.T + damping * _EYE6, err)
         biggest = float(np.max(np.abs(step)))
@@ -262,6 +273,31 @@ def _off_centre(arm: ArmModel, q: np.ndarray) -> float:
     return float(np.mean(np.abs(q - (lo + hi) / 2.0) / ((hi - lo) / 2.0)))
 
 
+REPORTED = 20  # candidates analysed in full to say why no start pose was found
+
+
+def _hopeless(
+    arm: ArmModel, q: np.ndarray, motions: Mapping[str, Sequence[Sequence[float]]], length_scale: float,
+    contacts: Callable[[np.ndarray], list[str]] | None, worst_allowed: float,
+) -> bool:
+    """Whether a start pose cannot be the one chosen, found before its full analysis: a motion unreachable,
+    too close to a joint limit, touching, or conditioned at `worst_allowed` or worse (the score it would need
+    to beat the best so far). Stops at the first such motion: most candidates fail on their first one."""
+    for offsets in motions.values():
+        for offset in offsets:
+            path, ok = tip_path(arm, q, offset)
+            if not ok:
+                return True
+            for step in path:
+                if condition_number(arm, step, length_scale) >= worst_allowed:
+                    return True
+                if float(np.min(margins(arm, step))) < MIN_MARGIN:
+                    return True
+            if contacts is not None and any(contacts(step) for step in path[4::5] + path[-1:]):
+                return True
+    return False
+
+
 def estimate_reach(arm: ArmModel, samples: int = 2000) -> float:
     """How far the tool tip gets from the first joint's axis [m]: the largest horizontal distance of the
     tip from the base's z axis over fixed pseudo-random configurations (a lower bound of the true reach)."""
@@ -274,6 +310,25 @@ def estimate_reach(arm: ArmModel, samples: int = 2000) -> float:
         p = arm.frame_pose(q, arm.tip_frame).translation
         best = max(best, float(math.hypot(p[0], p[1])))
     return best
+
+
+def tool_down_heights(arm: ArmModel, reach: float, samples: int = 4000) -> list[float]:
+    """Heights [m] where the tool can point down in front of the robot: the 50th, 65th, 80th and 95th
+    percentiles of the tool tip's height over fixed pseudo-random configurations whose tool points within 25
+    degrees of down, more than 0.3 of the reach in front (empty: none found). For an arm standing high (on a
+    torso), whose tool-down workspace is not where a table-mounted arm's is."""
+    rng = np.random.default_rng(2)
+    lo = np.where(np.isfinite(arm.lower), arm.lower, -math.pi)
+    hi = np.where(np.isfinite(arm.upper), arm.upper, math.pi)
+    found = []
+    for _ in range(samples):
+        q = lo + (hi - lo) * rng.random(arm.nv)
+        pose = arm.frame_pose(q, arm.tip_frame)
+        if pose.rotation[2, 2] < -0.9 and pose.translation[0] > 0.3 * reach:
+            found.append(float(pose.translation[2]))
+    if not found:
+        return []
+    return [float(np.percentile(found, p)) for p in (50, 65, 80, 95)]
 
 
 def _rot_z(yaw: float) -> np.ndarray:
@@ -308,7 +363,12 @@ def find_start_pose(
     seeds = _seeds(arm)
     best: tuple[float, PoseReport] | None = None
     closest: tuple[float, PoseReport] | None = None
+    rejected: list[tuple[np.ndarray, np.ndarray]] = []  # (q, tip) of candidates _hopeless turned down
     for z in heights:
+        # Every IK solution at this height with the least score its analysis could give (the worst condition
+        # number is at least the start's, the margin term at least -0.5); analysed best bound first, until no
+        # bound can beat the best score: the same choice as analysing them all, at a fraction of the cost.
+        candidates: list[tuple[float, int, np.ndarray, np.ndarray]] = []
         for x in xs:
             for y in ys:
                 for yaw in yaws:
@@ -321,32 +381,40 @@ def find_start_pose(
                         found.append(q)
                     for q in found:
                         condition = condition_number(arm, q, length_scale)
-                        if condition >= max_condition:
+                        if condition >= max_condition or lowest_joint(arm, q) < MIN_JOINT_HEIGHT:
                             continue
-                        # The score below is at least this (worst >= condition, the margin term >= -0.5):
-                        # a candidate that cannot beat the best so far is not analysed.
-                        if best is not None and condition + 2.0 * _off_centre(arm, q) - 0.5 >= best[0] - 1e-9:
-                            continue
-                        if lowest_joint(arm, q) < MIN_JOINT_HEIGHT:
-                            continue
-                        if contacts is not None and contacts(q):
-                            continue
-                        motions = motions_for(np.array([x, y, z]))
-                        report = analyse_pose(arm, q, motions, length_scale, contacts)
-                        worst = report.worst_condition
-                        # Lowest condition number first; then joints near the middle of their ranges (a
-                        # familiar posture rather than one wound round a +-2 pi joint) and wider margins.
-                        score = worst + 2.0 * _off_centre(arm, q) - 0.5 * min(report.min_margin, 1.0)
-                        usable = report.reachable and report.collision_free
-                        usable = usable and report.min_margin >= MIN_MARGIN
-                        if usable and worst < max_condition:
-                            if best is None or score < best[0] - 1e-9:
-                                best = (score, report)
-                        elif closest is None or score < closest[0]:
-                            closest = (score, report)
+                        bound = condition + 2.0 * _off_centre(arm, q) - 0.5
+                        candidates.append((bound, len(candidates), q, np.array([x, y, z])))
+        candidates.sort(key=lambda c: (c[0], c[1]))
+        for bound, _, q, tip in candidates:
+            if best is not None and bound >= best[0] - 1e-9:
+                break
+            if contacts is not None and contacts(q):
+                continue
+            # The worst condition number that could still beat the best score (whose margin term is >= -0.5).
+            limit = math.inf if best is None else best[0] - 1e-9 - 2.0 * _off_centre(arm, q) + 0.5
+            if _hopeless(arm, q, motions_for(tip), length_scale, contacts, min(max_condition, limit)):
+                rejected.append((q, tip))
+                continue
+            report = analyse_pose(arm, q, motions_for(tip), length_scale, contacts)
+            worst = report.worst_condition
+            # Lowest condition number first; then joints near the middle of their ranges (a familiar posture
+            # rather than one wound round a +-2 pi joint) and wider margins.
+            score = worst + 2.0 * _off_centre(arm, q) - 0.5 * min(report.min_margin, 1.0)
+            usable = report.reachable and report.collision_free and report.min_margin >= MIN_MARGIN
+            if usable and worst < max_condition:
+                if best is None or score < best[0] - 1e-9:
+                    best = (score, report)
+            elif closest is None or score < closest[0]:
+                closest = (score, report)
         if best is not None and z >= heights[min(1, len(heights) - 1)]:
             break  # a good pose at a moderate height: higher ones only shorten the follower's room
     if best is None:
+        for q, tip in rejected[:REPORTED]:  # the closest candidates' problems, for the message
+            report = analyse_pose(arm, q, motions_for(tip), length_scale, contacts)
+            score = report.worst_condition + 2.0 * _off_centre(arm, q) - 0.5 * min(report.min_margin, 1.0)
+            if closest is None or score < closest[0]:
+                closest = (score, report)
         none = "no tool-down IK solution in front of the robot"
         detail = "; ".join(closest[1].problems()) if closest else none
         raise StartPoseError(

@@ -11,7 +11,8 @@ every problem found:
   * the demonstrations' motions (config/demos.yaml) unreachable from the start pose, slowed by jog_arm's
     singularity threshold or stopped by its hard stop;
   * the scene's obstacle not where the compliant move can meet it (thesis_demos' preflight);
-  * named poses whose `start` is not the scene's start pose.
+  * named poses whose `start` is not the scene's start pose;
+  * held joints (outside the arm) that the scene and jog_arm hold at different positions.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from typing import Any
 
 import numpy as np
 import yaml
+from compliant_common.errors import StackError
 from contact_control.params import ContactControlSettings
 from control_stack.description import (
     DescriptionError,
@@ -36,7 +38,7 @@ from control_stack.description import (
     read_source,
 )
 from jog_arm.kinematics import ArmModel, KinematicsError
-from jog_arm.settings import JogSettings
+from jog_arm.settings import JogSettings, SettingsError, held_positions
 from thesis_demos.geometry import (
     DemoConfigError,
     demo_motions,
@@ -179,7 +181,15 @@ def check_package(root: str) -> list[str]:
     # Start pose, margins, the demos' motions.
     tip = jog.get("ee_frame_name", "tool_tip")
     try:
-        arm = ArmModel(urdf, tip)
+        held = held_positions(scene.get("held_joints") or [], "sim.yaml held_joints")
+        jog_held = held_positions(jog.get("held_joints") or [], "jog_arm.yaml held_joints")
+    except SettingsError as exc:
+        return [*problems, str(exc)]
+    if jog_held != held:
+        problems.append(f"held joints: sim.yaml held_joints {held} but jog_arm.yaml held_joints {jog_held} "
+                        "(jog_arm would model the arm elsewhere than the driver holds it)")
+    try:
+        arm = ArmModel(urdf, tip, tuple(jog.get("joint_names") or ()), held_positions=held)
     except KinematicsError as exc:
         return [*problems, f"jog_arm cannot model the arm: {exc}"]
     start = scene.get("start_pose") or {}
@@ -204,7 +214,10 @@ def check_package(root: str) -> list[str]:
         gap = float(tip_xyz[2] - obstacle.top) if geometry.compliant_direction < 0 else None
     contacts = None
     if np.all((q0 >= arm.lower) & (q0 <= arm.upper)):  # the scene refuses a start pose outside the limits
-        contacts = CollisionChecker(urdf, arm.joint_names, q0).contacts
+        try:
+            contacts = CollisionChecker(urdf, arm.joint_names, q0, held).contacts
+        except StackError as exc:  # the scene mujoco_driver would build refuses the files
+            return [*problems, f"sim.yaml: the simulated scene cannot be built: {exc}"]
     report = analyse_pose(arm, q0, demo_motions(geometry, approach=gap), scale, contacts)
     for name, m, lo, hi, q in zip(arm.joint_names, report.margins, arm.lower, arm.upper, q0, strict=True):
         if m < 0:

@@ -2,13 +2,14 @@
 simulation builds (mujoco_driver.scene), so a start pose the generator accepts does not collide there.
 
 Pure: mujoco and numpy, no ROS. Pairs of bodies at most `KIN_HOPS` apart in the kinematic tree are
-ignored (neighbouring links' meshes overlap at their joints by design), and so are pairs that are both fixed
-to the world (the base on the table).
+ignored (neighbouring links' meshes overlap at their joints by design), and so are pairs that the arm's
+joints do not move (the base on the table, a held mobile base's wheels on the floor) and pairs the scene
+itself leaves out (links overlapping in every posture: `mujoco_driver.scene`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import mujoco
 import numpy as np
@@ -29,20 +30,32 @@ class CollisionChecker:
         urdf_xml: The description (with sensor and tool).
         joint_names: The order of the angles given to :meth:`contacts`.
         inside: Angles within every joint's limits (the scene needs a valid start pose); default zeros.
+        held: Positions of the joints that are not in `joint_names` (the scene's held joints).
     """
 
     def __init__(
-        self, urdf_xml: str, joint_names: Sequence[str], inside: Sequence[float] | np.ndarray | None = None
+        self, urdf_xml: str, joint_names: Sequence[str], inside: Sequence[float] | np.ndarray | None = None,
+        held: Mapping[str, float] | None = None,
     ) -> None:
         # Any configuration within the limits will do for building the scene (`inside`, default all zero).
         start = dict(zip(joint_names, inside, strict=True)) if inside is not None else 0.0
-        cfg = SceneConfig.from_dict({"start_pose": start, "servo": {"kp": 1.0, "kv": 0.0}})
+        cfg = SceneConfig.from_dict({"start_pose": start, "servo": {"kp": 1.0, "kv": 0.0},
+                                     "held_joints": dict(held or {})})
         scene = build_scene(urdf_xml, cfg)
         self.model = scene.model
         self.data = mujoco.MjData(self.model)
         by_name = dict(zip(scene.joint_names, scene.qpos_adr, strict=True))
+        for name, value in (held or {}).items():
+            self.data.qpos[by_name[name]] = value
         self._adr = [int(by_name[j]) for j in joint_names]
         m = self.model
+        # Bodies the given joints move: a pair of bodies that none of them moves (the base on the table, a
+        # held torso's wheels on the floor) touches alike in every configuration and is ignored.
+        moving_joints = {m.joint(j).id for j in joint_names}
+        self._moving = np.zeros(m.nbody, dtype=bool)
+        for b in range(1, m.nbody):
+            own = any(m.body_jntadr[b] <= jid < m.body_jntadr[b] + m.body_jntnum[b] for jid in moving_joints)
+            self._moving[b] = own or self._moving[m.body_parentid[b]]
         m.geom_margin[:] = CLEARANCE
         depth = np.zeros(m.nbody, dtype=int)
         for b in range(1, m.nbody):
@@ -73,7 +86,7 @@ class CollisionChecker:
             if con.dist > CLEARANCE:
                 continue
             a, b = m.geom_bodyid[con.geom1], m.geom_bodyid[con.geom2]
-            if m.body_weldid[a] == 0 and m.body_weldid[b] == 0:
+            if not (self._moving[a] or self._moving[b]):
                 continue
             if self._hops(int(a), int(b)) <= KIN_HOPS:
                 continue

@@ -38,22 +38,24 @@ from control_stack.description import (
     find_example_robot_data,
     read_source,
 )
-from jog_arm.kinematics import ArmModel
+from jog_arm.kinematics import ArmModel, KinematicsError
 from thesis_demos.geometry import SURFACE_TRAVEL, DemoGeometry, demo_motions
 
 from robot_setup import templates
 from robot_setup.analysis import (
     LENGTH_SCALE,
+    PoseReport,
     StartPoseError,
     analyse_pose,
     estimate_reach,
     find_start_pose,
     lowest_joint,
     tip_path,
+    tool_down_heights,
 )
 from robot_setup.collisions import CollisionChecker
 from robot_setup.driver import DriverError, driver_interface
-from robot_setup.plan import Plan, RobotSpec, command_line, recorded_command
+from robot_setup.plan import Plan, RobotSpec, command_line, parse_held, parse_rpy, recorded_command
 from robot_setup.sensor_limits import contact_force_for
 
 # Plan, RobotSpec, command_line and recorded_command live in robot_setup.plan (the templates read them too);
@@ -120,6 +122,167 @@ def _default_base(root: str, children: dict, urdf_xml: str) -> str:
     return root
 
 
+def _chain(children: dict[str, list[tuple[str, str, ET.Element]]], base: str, tip: str) -> list[str]:
+    """The movable joints from `base` down to `tip`, in order.
+
+    Raises:
+        GeneratorError: `tip` is not below `base`.
+    """
+    parent = {child: (link, jtype, joint) for link, kids in children.items() for child, jtype, joint in kids}
+    joints, link = [], tip
+    while link != base:
+        if link not in parent:
+            raise GeneratorError(f"TIP={tip!r} is not below BASE={base!r}: choose a BASE on the way from "
+                                 f"the URDF root to {tip}")
+        link, jtype, joint = parent[link]
+        if jtype not in ("fixed", "floating", "planar"):
+            joints.append(joint.get("name", ""))
+    if not joints:
+        raise GeneratorError(f"no movable joint between BASE={base!r} and TIP={tip!r}")
+    return joints[::-1]
+
+
+def _held_positions(
+    urdf_xml: str, chain: Sequence[str], given: dict[str, float], spec: RobotSpec
+) -> tuple[tuple[str, float], ...]:
+    """Every movable joint outside the chain and where it is held: HELD's value, else 0 clamped into its
+    limits (URDF order).
+
+    Raises:
+        GeneratorError: HELD names a joint of the chain, one that is not in the description, or a position
+            outside its limits.
+    """
+    joints = {j.get("name", ""): j for j in ET.fromstring(urdf_xml).findall("joint")
+              if j.get("type") not in ("fixed", "floating", "planar")}
+    for name in given:
+        if name in chain:
+            raise GeneratorError(f"HELD={name}: {name} is an arm joint (between BASE and TIP={spec.tip})")
+        if name not in joints:
+            raise GeneratorError(f"HELD={name}: not a movable joint of the description (outside the arm: "
+                                 f"{[j for j in joints if j not in chain]})")
+    held = []
+    for name, joint in joints.items():
+        if name in chain:
+            continue
+        limit = joint.find("limit")
+        bounded = limit is not None and joint.get("type") != "continuous"
+        lo = float(limit.get("lower", "-inf")) if bounded and limit is not None else -math.inf
+        hi = float(limit.get("upper", "inf")) if bounded and limit is not None else math.inf
+        if name in given:
+            if not lo <= given[name] <= hi:
+                raise GeneratorError(f"HELD={name}={given[name]:g}: outside its limits [{lo:g}, {hi:g}]")
+            value = given[name]
+        else:
+            value = min(max(0.0, lo), hi)
+        held.append((name, round(value, 6)))
+    return tuple(held)
+
+
+# Adapter angles tried when the straight mounting cannot point the tool down (roll, pitch, yaw of the sensor
+# on the flange) [rad]: right-angle and 45-degree brackets about the flange's x and y axes.
+ADAPTERS = tuple(
+    (r * math.pi / 4.0, p * math.pi / 4.0, 0.0) for r, p in
+    ((2, 0), (-2, 0), (0, 2), (0, -2), (1, 0), (-1, 0), (0, 1), (0, -1))
+)
+
+
+def _tool(spec: RobotSpec, rpy: Sequence[float]) -> ToolSpec:
+    return ToolSpec(parent=spec.tip, mass=spec.tool_mass, com=TOOL_COM, size=TOOL_SIZE,
+                    ft_rpy=(float(rpy[0]), float(rpy[1]), float(rpy[2])))
+
+
+def _arm(urdf_xml: str, chain: Sequence[str], held: Sequence[tuple[str, float]], name: str) -> ArmModel:
+    try:
+        return ArmModel(urdf_xml, ToolSpec.tip_name, chain, held_positions=dict(held))
+    except KinematicsError as exc:
+        raise GeneratorError(f"jog_arm cannot model the {name}: {exc}") from exc
+
+
+def _tool_stuck(arm: ArmModel, contacts: Callable[[Sequence[float] | np.ndarray], list[str]]) -> str:
+    """What the tool touches in every one of 8 fixed pseudo-random postures ("" if nothing): a mounting that
+    puts it inside the wrist, which no start pose search can mend (found in milliseconds, not seconds)."""
+    rng = np.random.default_rng(4)
+    lo = np.where(np.isfinite(arm.lower), arm.lower, -math.pi)
+    hi = np.where(np.isfinite(arm.upper), arm.upper, math.pi)
+    always: set[str] | None = None
+    for _ in range(8):
+        touching = {pair for pair in contacts(lo + (hi - lo) * rng.random(arm.nv))
+                    if ToolSpec.name in pair.split(" / ")}
+        always = touching if always is None else always & touching
+        if not always:
+            return ""
+    return ", ".join(sorted(always or ()))
+
+
+def _start_pose(
+    arm: ArmModel, reach: float, motions: dict, heights: list[float],
+    contacts: Callable[[Sequence[float] | np.ndarray], list[str]],
+) -> PoseReport:
+    """find_start_pose, after the quick check that the tool is not stuck in the arm.
+
+    Raises:
+        StartPoseError: Why there is none.
+    """
+    stuck = _tool_stuck(arm, contacts)
+    if stuck:
+        raise StartPoseError(f"the tool, mounted this way, touches the arm in every posture ({stuck})")
+    return find_start_pose(arm, reach, lambda tip: motions, heights=heights, contacts=contacts)
+
+
+def _adapter(
+    stock: str, spec: RobotSpec, removed: tuple[str, ...], chain: Sequence[str],
+    held: Sequence[tuple[str, float]], reach: float, motions: dict, gap: float, straight: str,
+    log: Callable[[str], object],
+) -> tuple[
+    tuple[float, float, float], str, ArmModel, Callable[[Sequence[float] | np.ndarray], list[str]], PoseReport
+]:
+    """The adapter angle (of ADAPTERS) whose start pose keeps the widest joint-limit margin on the demos'
+    motions (ties: the lower worst condition number), with its description, model, collision check and pose.
+
+    Raises:
+        GeneratorError: No angle works either (the straight mounting's reason, and the angles tried).
+    """
+    best = None
+    for rpy in ADAPTERS:
+        urdf_xml = build_description(stock, _tool(spec, rpy), removed)
+        arm = _arm(urdf_xml, chain, held, spec.name)
+        bounded = np.isfinite(arm.lower) & np.isfinite(arm.upper)
+        mid = (np.where(bounded, arm.lower, 0.0) + np.where(bounded, arm.upper, 0.0)) / 2.0
+        contacts = CollisionChecker(urdf_xml, arm.joint_names, mid, dict(held)).contacts
+        words = f"roll {math.degrees(rpy[0]):g} pitch {math.degrees(rpy[1]):g} deg"
+        try:
+            found = _start_pose(arm, reach, motions, _heights(arm, reach, gap), contacts)
+        except StartPoseError as exc:
+            stuck = str(exc) if "touches the arm" in str(exc) else ""
+            log(f"[robot]   adapter {words}: no start pose{f' ({stuck})' if stuck else ''}")
+            continue
+        log(f"[robot]   adapter {words}: margin {found.min_margin:.2f} rad, condition <= "
+            f"{found.worst_condition:.2f}")
+        key = (-round(found.min_margin, 3), found.worst_condition)
+        if best is None or key < best[0]:
+            best = (key, (rpy, urdf_xml, arm, contacts, found))
+    if best is None:
+        raise GeneratorError(f"{straight}; nor with the sensor on an adapter at 45 or 90 degrees about the "
+                             "flange's x or y axis: give the mounting with TOOL_RPY=roll,pitch,yaw")
+    rpy = best[1][0]
+    log(f"[robot] adapter chosen: TOOL_RPY={','.join(f'{v:.10g}' for v in rpy)} (roll "
+        f"{math.degrees(rpy[0]):g}, pitch {math.degrees(rpy[1]):g} deg), into config/description.args")
+    return best[1]
+
+
+def _heights(arm: ArmModel, reach: float, gap: float) -> list[float]:
+    """The start pose search's tool-tip heights: over the table (the URDF root's z = 0 plane) by a fraction of
+    the reach; for an arm whose first joint stands higher than half its reach over the table (on a torso),
+    where its tool can point down."""
+    bounded = np.isfinite(arm.lower) & np.isfinite(arm.upper)
+    mid = (np.where(bounded, arm.lower, 0.0) + np.where(bounded, arm.upper, 0.0)) / 2.0
+    first = arm.joint_names[0]
+    shoulder = float(arm.frame_pose(mid, first).translation[2]) if arm.has_frame(first) else 0.0
+    fractions = [reach * f for f in (0.2, 0.28, 0.36, 0.45)]
+    return [h for h in (fractions if shoulder < 0.5 * reach else tool_down_heights(arm, reach))
+            if h >= gap + 0.04]
+
+
 def _round(value: float, step: float) -> float:
     return round(round(value / step) * step, 6)
 
@@ -147,18 +310,23 @@ def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
     base = spec.base or _default_base(root, children, stock)
     if base not in links:
         raise GeneratorError(f"BASE={base!r} is not a link of {spec.urdf}; links: {sorted(links)}")
+    chain = _chain(children, base, spec.tip)
     removed = tuple(child for child, _, _ in children.get(spec.tip, []))
-    tool = ToolSpec(parent=spec.tip, mass=spec.tool_mass, com=TOOL_COM, size=TOOL_SIZE)
-    urdf_xml = build_description(stock, tool, removed)
+    rpy = spec.tool_rpy if spec.tool_rpy is not None else (0.0, 0.0, 0.0)
+    urdf_xml = build_description(stock, _tool(spec, rpy), removed)
+    held = _held_positions(urdf_xml, chain, dict(spec.held), spec)
     missing = driver.missing_links({lnk.get("name", "") for lnk in ET.fromstring(urdf_xml).findall("link")})
     if missing:
         raise GeneratorError(
             f"DRIVER={spec.driver}: the profile's frames are not in the {name} description (the emulated "
             f"driver would refuse it): {'; '.join(missing)}"
         )
-    arm = ArmModel(urdf_xml, tool.tip_name)
+    arm = _arm(urdf_xml, chain, held, name)
     reach = estimate_reach(arm)
     log(f"[robot] {spec.name}: {arm.nv} joints {list(arm.joint_names)}, tool-tip reach ~{reach:.2f} m")
+    if held:
+        log(f"[robot] held (outside {base} .. {spec.tip}): "
+            + ", ".join(f"{j} = {v:g}" for j, v in held))
     log(f"[robot] {driver.summary()}")
     scale = min(1.0, reach / REFERENCE_REACH)
     gap = _round(max(0.04, 0.07 * scale), 0.005)
@@ -178,14 +346,23 @@ def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
         force = contact_force_for(spec.driver, geometry.contact_force_limit)
         log(f"[robot] demos' contact force with {spec.driver}: {force.limit:g} N ({force.comment()})")
     motions = demo_motions(geometry, approach=gap)
-    heights = [h for h in (reach * f for f in (0.2, 0.28, 0.36, 0.45)) if h >= gap + 0.04]
     bounded = np.isfinite(arm.lower) & np.isfinite(arm.upper)
     mid = (np.where(bounded, arm.lower, 0.0) + np.where(bounded, arm.upper, 0.0)) / 2.0
-    contacts = CollisionChecker(urdf_xml, arm.joint_names, mid).contacts
+    heights = _heights(arm, reach, gap)
+    contacts: Callable[[Sequence[float] | np.ndarray], list[str]]
+    contacts = CollisionChecker(urdf_xml, arm.joint_names, mid, dict(held)).contacts
+    adapter = ""
     try:
-        found = find_start_pose(arm, reach, lambda tip: motions, heights=heights, contacts=contacts)
+        found = _start_pose(arm, reach, motions, heights, contacts)
     except StartPoseError as exc:
-        raise GeneratorError(str(exc)) from exc
+        if spec.tool_rpy is not None:  # the user's mounting: say why it does not work
+            raise GeneratorError(f"TOOL_RPY={','.join(f'{v:g}' for v in rpy)}: {exc}") from exc
+        log("[robot] the straight mounting cannot point the tool down for the demos; trying adapter angles")
+        mounted = _adapter(stock, spec, removed, chain, held, reach, motions, gap,
+                           f"straight on {spec.tip}: {exc}", log)
+        rpy, urdf_xml, arm, contacts, found = mounted
+        adapter = (f"an adapter make robot chose: the straight mounting had no tool-down start pose, this "
+                   f"angle keeps the most margin ({found.min_margin:.2f} rad)")
     q0 = np.round(found.q, 4)  # what the files say, analysed again as written
     start = analyse_pose(arm, q0, motions, contacts=contacts)
     tip = start.tip
@@ -204,7 +381,8 @@ def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
     home = np.round(path[-1], 4) if ok and lift.reachable else q0
     efforts = []
     robot = ET.fromstring(urdf_xml)
-    for name in arm.joint_names:
+    servo_joints = (*arm.joint_names, *(j for j, _ in held))
+    for name in servo_joints:
         joint = next(j for j in robot.findall("joint") if j.get("name") == name)
         limit = joint.find("limit")
         efforts.append(float(limit.get("effort", 0.0)) if limit is not None else 0.0)
@@ -212,7 +390,8 @@ def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
     kv = tuple(_round(k * KV_RATIO, 1.0) for k in kp)
     armature = 0.2 if max(efforts) > 100.0 else 0.1
     plan = Plan(
-        spec=spec, source=source, removed=removed, base=base, urdf_xml=urdf_xml, joints=arm.joint_names,
+        spec=spec, source=source, removed=removed, base=base, tool_rpy=rpy, adapter=adapter, held=held,
+        servo_joints=servo_joints, urdf_xml=urdf_xml, joints=arm.joint_names,
         reach=reach, geometry=geometry, gap=gap, obstacle_size=obstacle_size,
         obstacle_position=obstacle_position, start=start, home=home, threshold=threshold, hard_stop=hard_stop,
         kp=kp, kv=kv, armature=armature, efforts=tuple(efforts), driver=driver,
@@ -281,12 +460,25 @@ def main(argv: Sequence[str] | None = None) -> int:
         "--driver", default="", help="the real driver the hardware files are for: a mujoco_driver profile "
         "name (one in mujoco_driver config/profiles) or YAML path (default: a generic ros_control driver)"
     )
+    parser.add_argument(
+        "--tool-rpy", default="", help="the sensor's mounting on the flange, roll,pitch,yaw [rad] (default: "
+        "straight, or an adapter angle found when straight cannot point the tool down)"
+    )
+    parser.add_argument(
+        "--held", default="", help="joint=position,... of joints outside BASE..TIP (default: 0 within limits)"
+    )
     parser.add_argument("--src", default=os.path.join(os.getcwd(), "src"), help="workspace src/ directory")
     args = parser.parse_args(argv)
-    spec = RobotSpec(args.name, args.urdf, args.tip, args.base, args.tool_mass, args.driver)
+    try:
+        rpy = parse_rpy(args.tool_rpy) if args.tool_rpy else None
+        held = parse_held(args.held)
+    except ValueError as exc:
+        print(f"make robot: error: {exc}", file=sys.stderr)
+        return 2
+    spec = RobotSpec(args.name, args.urdf, args.tip, args.base, args.tool_mass, args.driver, rpy, held)
     try:
         plan = plan_robot(spec)
-    except (GeneratorError, DescriptionError) as exc:
+    except StackError as exc:  # GeneratorError, DescriptionError, the scene's and jog_arm's: one line each
         print(f"make robot: error: {exc}", file=sys.stderr)
         return 2
     root = write_package(plan, args.src)

@@ -110,17 +110,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     runner = DemoRunner(Names(base_frame=args.base_frame, wrench=args.wrench_topic), timeout=args.timeout)
     results = []
     cannot: dict[str, str] = {}
-    if setup.checks_scene:
-        # Plain words before anything moves: what this arm's start pose and scene do not allow.
-        tip = runner.start_tip()
-        cannot = setup.preflight(tip)
-        scenarios = setup.fitted(scenarios, tip)
-        for name, reason in cannot.items():
-            if any(s.name == name for s in scenarios):
-                print(f"[CANNOT] {name}: this arm cannot do it as configured: {reason}", flush=True)
-    floor = runner.noise_floor()
-    sigmas = runner.contact_setting("noise_limit_sigmas")
-    global_force = runner.contact_setting("global_max_force")
+    try:
+        if setup.checks_scene:
+            # Plain words before anything moves: what this arm's start pose and scene do not allow.
+            tip = runner.start_tip()
+            cannot = setup.preflight(tip)
+            scenarios = setup.fitted(scenarios, tip)
+            for name, reason in cannot.items():
+                if any(s.name == name for s in scenarios):
+                    print(f"[CANNOT] {name}: this arm cannot do it as configured: {reason}", flush=True)
+        floor = runner.noise_floor()
+        sigmas = runner.contact_setting("noise_limit_sigmas")
+        global_force = runner.contact_setting("global_max_force")
+    except (TimeoutError, RuntimeError) as exc:  # the stack never got ready: why, not a traceback
+        print(f"run_demos: the stack is not ready for the demonstrations: {exc}", file=sys.stderr, flush=True)
+        return 1
     for scenario in scenarios:
         if scenario.name in cannot:
             continue
@@ -131,7 +135,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             continue
         try:
             recording = runner.run(scenario, args.sensor_frame)
-        except RuntimeError as exc:  # a refused request: the reason, not a traceback
+        except (RuntimeError, TimeoutError) as exc:  # a refused request or no answer: the reason
             print(f"[FAIL] {scenario.name}: {exc}", flush=True)
             results.append((scenario, Verdict(False, str(exc), {}), ""))
             continue

@@ -6,7 +6,7 @@ from __future__ import annotations
 from robot_setup.driver import GENERIC_TRAJECTORY_TOPIC, DriverInterface
 from robot_setup.plan import Plan, command_line
 from robot_setup.templates.driver_text import MESSAGE, switch_words, written
-from robot_setup.templates.jog_arm_yaml import thresholds
+from robot_setup.templates.jog_arm_yaml import chain, thresholds
 from robot_setup.templates.text import comment, num
 
 __all__ = ["jog_arm_hardware_yaml"]
@@ -34,7 +34,7 @@ simu: false
 incoming_cmd_timeout: 0.1
 joint_state_timeout: 0.1
 low_pass_filter_coeff: 2.5
-{thresholds(plan)}"""
+{thresholds(plan)}{chain(plan)}"""
 
 
 def _pub_period(d: DriverInterface) -> str:
@@ -76,5 +76,5 @@ simu: false
 incoming_cmd_timeout: 0.1
 joint_state_timeout: {d.state_timeout:g}              # [s] {num(d.state_timeout * d.rate)} periods of the driver's joint states (at least 0.1 s)
 low_pass_filter_coeff: 2.5
-{thresholds(plan)}"""
+{thresholds(plan)}{chain(plan)}"""
 

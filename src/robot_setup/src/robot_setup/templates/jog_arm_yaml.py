@@ -4,9 +4,21 @@
 from __future__ import annotations
 
 from robot_setup.plan import Plan
+from robot_setup.templates.sim_yaml import held_section
 from robot_setup.templates.text import generated_by
 
-__all__ = ["jog_arm_yaml", "thresholds"]
+__all__ = ["chain", "jog_arm_yaml", "thresholds"]
+
+
+def chain(plan: Plan) -> str:
+    """The controlled joints and the held ones, when the description has joints outside the arm (also in
+    jog_arm_hardware.yaml); empty otherwise (jog_arm takes the joints from the root to the tip)."""
+    if not plan.held:
+        return ""
+    return f"""
+# The arm's joints ({plan.base} .. {plan.spec.tip}), in the order of the driver's velocity controller:
+joint_names: [{", ".join(plan.joints)}]
+{held_section(plan).lstrip()}"""
 
 
 def thresholds(plan: Plan) -> str:
@@ -44,4 +56,4 @@ incoming_cmd_timeout: 0.1           # [s]
 joint_state_timeout: 0.2            # [s]
 low_pass_filter_coeff: 2.0
 
-{thresholds(plan)}"""
+{thresholds(plan)}{chain(plan)}"""

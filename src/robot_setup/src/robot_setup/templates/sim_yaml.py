@@ -8,7 +8,21 @@ import math
 from robot_setup.plan import Plan
 from robot_setup.templates.text import generated_by, joints, num
 
-__all__ = ["sim_yaml"]
+__all__ = ["held_section", "sim_yaml"]
+
+
+def held_section(plan: Plan, indent: int = 0) -> str:
+    """`held_joints:` with its comment (also in jog_arm's files); empty when every joint is an arm joint."""
+    if not plan.held:
+        return ""
+    values = joints([v for _, v in plan.held], [f"- {j}" for j, _ in plan.held], "{:g}", indent + 2)
+    pad = " " * indent
+    return f"""
+{pad}# Joints outside the arm ({plan.base} .. {plan.spec.tip}): held here [rad or m] (make robot HELD=, default 0
+{pad}# within the limits); jog_arm and named_poses never move them. sim.yaml and jog_arm*.yaml list the same.
+{pad}held_joints:
+{values}
+"""
 
 
 def sim_yaml(plan: Plan) -> str:
@@ -39,7 +53,7 @@ table:
 # motions; every bounded joint >= {closest:.2f} rad from its limits (>= {s.min_margin:.2f} rad on the motions).
 start_pose:
 {joints(s.q, plan.joints)}
-
+{held_section(plan)}
 # Obstacle for the compliant-move demo: a block on the table under the tool tip, its top
 # (z = {plan.obstacle_size[2]:.3f}) {plan.gap * 100:.1f} cm below the tip at the start pose.
 obstacle:
@@ -51,9 +65,9 @@ obstacle:
 # efforts ({', '.join(num(e) for e in plan.efforts)} Nm). kp = 120 Nm/rad per Nm of effort (1000..20000), kv = 0.02 s x kp.
 servo:
   kp:                      # [Nm/rad]
-{joints(plan.kp, plan.joints, "{:.1f}", 4)}
+{joints(plan.kp, plan.servo_joints, "{:.1f}", 4)}
   kv:                      # [Nm s/rad]
-{joints(plan.kv, plan.joints, "{:.1f}", 4)}
+{joints(plan.kv, plan.servo_joints, "{:.1f}", 4)}
   armature: {plan.armature}            # reflected rotor inertia per joint [kg m^2]
   max_acceleration: 4.0    # [rad/s^2] setpoint acceleration limit (above jog_arm's 3 rad/s^2)
   payload_feedforward: true
