@@ -99,3 +99,11 @@ def test_an_arm_with_no_tool_down_pose_straight_or_on_any_adapter_is_refused_in_
     assert code == 2 and err.count("\n") == 1, err
     assert "nor with the sensor on an adapter at 45 or 90 degrees" in err and "TOOL_RPY=" in err
     assert out.count("[robot]   adapter") == 8
+
+
+def test_a_file_that_is_not_a_urdf_is_refused_in_one_line(tmp_path, capsys):
+    bad = tmp_path / "arm.urdf"
+    bad.write_text("<robot name='x'><link name='a'></robot>")
+    assert main(["--name", "t", "--urdf", str(bad), "--tip", "a", "--src", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("make robot: error: the URDF is not XML: "), err

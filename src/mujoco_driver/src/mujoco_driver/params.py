@@ -46,7 +46,8 @@ class DriverSettings:
     )
     start_pose: Any = param(
         None, shown_default="the scene's", unit="rad", shown_range="a list or a mapping",
-        doc="override: list in URDF joint order or `{joint: angle}`; `~reset` returns here", type="any",
+        doc="override: list in URDF joint order (the arm's joints: held ones excluded) or `{joint: angle}`; "
+        "`~reset` returns here", type="any",
     )
     timestep: float = param(
         0.0, unit="s", ge=0.0, le=0.01, shown_default="the scene's",

@@ -45,7 +45,7 @@ LENGTH_SCALE = JogSettings.singularity_length_scale  # [m] jog_arm's default
 IK_TOLERANCE = 1e-6  # [m, rad] a pose counts as reached below this error
 # solve_ik gives up when STALL_ITERATIONS iterations left the error above STALL_ERROR and above STALL_RATIO of
 # what it was (generating the UR3's and the Jaco2's packages gives the same files with and without this).
-STALL_ITERATIONS, STALL_RATIO, STALL_ERROR = 25, 0.9, 1e-3
+STALL_ITERATIONS, STALL_RATIO, STALL_ERROR = 20, 0.5, 1e-3
 PATH_STEPS = 20
 # A start pose is refused closer than this to a joint limit anywhere on the demos' motions [rad].
 MIN_MARGIN = 0.15

@@ -72,6 +72,7 @@ TOOL_COM = (0.0, 0.0, 0.05)  # [m] in the sensor frame
 # Servo gain per newton-metre of the URDF's joint effort, capped (stiff like an industrial controller).
 KP_PER_NM, KP_MAX, KP_MIN = 120.0, 20000.0, 1000.0
 KV_RATIO = 0.02  # kv = kp * this [s]
+MIN_JOINTS = 6  # jog_arm's JogCalcs refuses fewer (it follows 6-D twists)
 
 
 class GeneratorError(StackError):
@@ -95,8 +96,15 @@ def _source(urdf: str) -> tuple[str, str]:
 
 
 def _tree(urdf_xml: str) -> tuple[str, dict[str, list[tuple[str, str, ET.Element]]]]:
-    """(root link, parent link -> [(child link, joint type, joint element)])."""
-    robot = ET.fromstring(urdf_xml)
+    """(root link, parent link -> [(child link, joint type, joint element)]).
+
+    Raises:
+        GeneratorError: Not XML.
+    """
+    try:
+        robot = ET.fromstring(urdf_xml)
+    except ET.ParseError as exc:
+        raise GeneratorError(f"the URDF is not XML: {exc}") from exc
     children: dict[str, list[tuple[str, str, ET.Element]]] = {}
     child_links = set()
     for joint in robot.findall("joint"):
@@ -322,6 +330,12 @@ def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
             f"driver would refuse it): {'; '.join(missing)}"
         )
     arm = _arm(urdf_xml, chain, held, name)
+    if arm.nv < MIN_JOINTS:
+        raise GeneratorError(
+            f"{arm.nv} joints between {base} and {spec.tip} ({', '.join(arm.joint_names)}): jog_arm follows "
+            f"6-D twists and needs {MIN_JOINTS} or more; arms with fewer are not supported yet (robot_setup "
+            "README)"
+        )
     reach = estimate_reach(arm)
     log(f"[robot] {spec.name}: {arm.nv} joints {list(arm.joint_names)}, tool-tip reach ~{reach:.2f} m")
     if held:
