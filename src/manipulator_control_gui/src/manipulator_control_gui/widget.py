@@ -56,18 +56,38 @@ _LAW_TIPS = {
 
 
 class _Bridge(QObject):
-    """Carries results from ROS threads to the UI thread (queued connections)."""
+    """Carries results from ROS threads to the UI thread (queued connections).
+
+    It has no Qt parent, so it is never deleted with the widget while a ROS thread emits on it (a status
+    callback or a service answer can still run after `shutdown`): emitting on a QObject whose C++ side is
+    being destroyed crashed the process (segfaults in the GUI tests, rarely, on a busy machine). `close`
+    disconnects it; later results go nowhere."""
 
     status = Signal(object)
     availability = Signal(object)
     answer = Signal(str, object)
 
+    def __init__(self) -> None:
+        super().__init__()
+        self._closed = False
+
     def send(self, signal_name: str, *args: Any) -> None:
-        """Emits from any thread; a late result after the widget was deleted is dropped."""
+        """Emits from any thread; after `close`, drops the result."""
+        if self._closed:
+            return
         try:
             getattr(self, signal_name).emit(*args)
-        except RuntimeError:  # the C++ object is gone: the window was closed while a call was in flight
+        except RuntimeError:  # the interpreter is shutting down and took the C++ object with it
             pass
+
+    def close(self) -> None:
+        """No more deliveries: the widget is going away."""
+        self._closed = True
+        for signal in (self.status, self.availability, self.answer):
+            try:
+                signal.disconnect()
+            except TypeError:  # nothing connected
+                pass
 
 
 class _AxisRow:
@@ -147,7 +167,7 @@ class ControlWidget(QWidget):
         self._filling = False
         self._awaiting_reason = False  # a refusal came back; its reason follows on the status topic
         self._laws_service = False  # contact_control offers ConfigureLaws (answers with the reason)
-        self._bridge = _Bridge(self)
+        self._bridge = _Bridge()  # no parent: see _Bridge
         self._bridge.status.connect(self._show_status)
         self._bridge.availability.connect(self._show_availability)
         self._bridge.answer.connect(self._show_call_result)
@@ -430,3 +450,4 @@ class ControlWidget(QWidget):
         """Stops the timers and the ROS side; call before the widget goes away."""
         self._status_timer.stop()
         self.client.shutdown()
+        self._bridge.close()
