@@ -95,3 +95,22 @@ def test_a_follower_speed_cap_comes_from_configure_laws_only():
     req.x.velocity = -0.05
     with pytest.raises(Exception, match="speed cap"):
         validate_laws_request(req)
+
+
+def test_a_push_on_the_tool_far_below_the_base_frame_does_not_turn_the_guided_tool():
+    """The torque is taken about the end effector, not the control frame's origin: TIAGo's tool works 0.6 m
+    below its torso frame, and about that origin a 6 N push read 3.6 Nm, over the 2.5 Nm rotational
+    deadband, so hand-guiding turned the tool while it was pushed along a line."""
+    sensor = [[1.0, 0, 0, 0.5], [0, 1.0, 0, 0.0], [0, 0, 1.0, -0.6], [0, 0, 0, 1.0]]
+    eef = [[1.0, 0, 0, 0.5], [0, 1.0, 0, 0.0], [0, 0, 1.0, -0.72], [0, 0, 0, 1.0]]  # the tool tip 0.12 m below
+    poses = {"ft_sensor": sensor, "tool_tip": eef}
+    settings = load_settings({"tare_on_startup": False, "lp_filter_enabled": False, "fixed_frame": "base",
+                              "control_frame": "base", "velocity_command_frame": "base",
+                              "ft_sensor_frame": "ft_sensor", "eef_frame": "tool_tip"})
+    st = ContactStage(settings, lambda frame: [row[:] for row in poses.get(frame, IDENTITY)])
+    t, _ = run(st, (0.0,) * 6, 0.1, 0.0)
+    assert st.guide(True, [], t)[0].ok
+    t, v = run(st, (6.0, 0, 0, 0, 0, 0), 0.5, t)  # 6 N along X at the sensor: 0.72 Nm about the tool tip
+    assert v is not None and v[0] > 0.1 and v[3:] == (0.0, 0.0, 0.0), v
+    t, v = run(st, (0.0, 0, 0, 0, 3.0, 0), 0.5, t)  # a twist of the hand over the deadband turns it
+    assert v is not None and v[4] > 0.0, v
