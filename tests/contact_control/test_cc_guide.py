@@ -102,7 +102,7 @@ def test_a_push_on_the_tool_far_below_the_base_frame_does_not_turn_the_guided_to
     below its torso frame, and about that origin a 6 N push read 3.6 Nm, over the 2.5 Nm rotational
     deadband, so hand-guiding turned the tool while it was pushed along a line."""
     sensor = [[1.0, 0, 0, 0.5], [0, 1.0, 0, 0.0], [0, 0, 1.0, -0.6], [0, 0, 0, 1.0]]
-    eef = [[1.0, 0, 0, 0.5], [0, 1.0, 0, 0.0], [0, 0, 1.0, -0.72], [0, 0, 0, 1.0]]  # the tool tip 0.12 m below
+    eef = [[1.0, 0, 0, 0.5], [0, 1.0, 0, 0.0], [0, 0, 1.0, -0.72], [0, 0, 0, 1.0]]  # tool tip, 0.12 m lower
     poses = {"ft_sensor": sensor, "tool_tip": eef}
     settings = load_settings({"tare_on_startup": False, "lp_filter_enabled": False, "fixed_frame": "base",
                               "control_frame": "base", "velocity_command_frame": "base",
