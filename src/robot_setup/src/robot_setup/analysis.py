@@ -34,6 +34,7 @@ __all__ = [
     "find_start_pose",
     "lowest_joint",
     "margins",
+    "sample_range",
     "solve_ik",
     "tip_path",
     "tool_down_heights",
@@ -256,10 +257,15 @@ def analyse_pose(
     )
 
 
+def sample_range(arm: ArmModel) -> tuple[np.ndarray, np.ndarray]:
+    """Each joint's limits, +-pi for an unbounded one: where pseudo-random postures are drawn."""
+    return (np.where(np.isfinite(arm.lower), arm.lower, -math.pi),
+            np.where(np.isfinite(arm.upper), arm.upper, math.pi))
+
+
 def _seeds(arm: ArmModel, count: int = 6) -> list[np.ndarray]:
     """Deterministic IK seeds: mid-range, then fixed pseudo-random configurations within the limits."""
-    lo = np.where(np.isfinite(arm.lower), arm.lower, -math.pi)
-    hi = np.where(np.isfinite(arm.upper), arm.upper, math.pi)
+    lo, hi = sample_range(arm)
     rng = np.random.default_rng(0)
     seeds = [(lo + hi) / 2.0]
     seeds += [lo + (hi - lo) * (0.15 + 0.7 * rng.random(arm.nv)) for _ in range(count - 1)]
@@ -268,8 +274,7 @@ def _seeds(arm: ArmModel, count: int = 6) -> list[np.ndarray]:
 
 def _off_centre(arm: ArmModel, q: np.ndarray) -> float:
     """Mean distance of the joints from the middle of their ranges, as a fraction of the half range."""
-    lo = np.where(np.isfinite(arm.lower), arm.lower, -math.pi)
-    hi = np.where(np.isfinite(arm.upper), arm.upper, math.pi)
+    lo, hi = sample_range(arm)
     return float(np.mean(np.abs(q - (lo + hi) / 2.0) / ((hi - lo) / 2.0)))
 
 
@@ -302,8 +307,7 @@ def estimate_reach(arm: ArmModel, samples: int = 2000) -> float:
     """How far the tool tip gets from the first joint's axis [m]: the largest horizontal distance of the
     tip from the base's z axis over fixed pseudo-random configurations (a lower bound of the true reach)."""
     rng = np.random.default_rng(1)
-    lo = np.where(np.isfinite(arm.lower), arm.lower, -math.pi)
-    hi = np.where(np.isfinite(arm.upper), arm.upper, math.pi)
+    lo, hi = sample_range(arm)
     best = 0.0
     for _ in range(samples):
         q = lo + (hi - lo) * rng.random(arm.nv)
@@ -318,8 +322,7 @@ def tool_down_heights(arm: ArmModel, reach: float, samples: int = 4000) -> list[
     degrees of down, more than 0.3 of the reach in front (empty: none found). For an arm standing high (on a
     torso), whose tool-down workspace is not where a table-mounted arm's is."""
     rng = np.random.default_rng(2)
-    lo = np.where(np.isfinite(arm.lower), arm.lower, -math.pi)
-    hi = np.where(np.isfinite(arm.upper), arm.upper, math.pi)
+    lo, hi = sample_range(arm)
     found = []
     for _ in range(samples):
         q = lo + (hi - lo) * rng.random(arm.nv)

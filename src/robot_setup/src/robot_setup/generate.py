@@ -50,6 +50,7 @@ from robot_setup.analysis import (
     estimate_reach,
     find_start_pose,
     lowest_joint,
+    sample_range,
     tip_path,
     tool_down_heights,
 )
@@ -194,6 +195,12 @@ ADAPTERS = tuple(
 )
 
 
+def _mid(arm: ArmModel) -> np.ndarray:
+    """The middle of each bounded joint's range, 0 for an unbounded one (a posture inside every limit)."""
+    bounded = np.isfinite(arm.lower) & np.isfinite(arm.upper)
+    return (np.where(bounded, arm.lower, 0.0) + np.where(bounded, arm.upper, 0.0)) / 2.0
+
+
 def _tool(spec: RobotSpec, rpy: Sequence[float]) -> ToolSpec:
     return ToolSpec(parent=spec.tip, mass=spec.tool_mass, com=TOOL_COM, size=TOOL_SIZE,
                     ft_rpy=(float(rpy[0]), float(rpy[1]), float(rpy[2])))
@@ -210,8 +217,7 @@ def _tool_stuck(arm: ArmModel, contacts: Callable[[Sequence[float] | np.ndarray]
     """What the tool touches in every one of 8 fixed pseudo-random postures ("" if nothing): a mounting that
     puts it inside the wrist, which no start pose search can mend (found in milliseconds, not seconds)."""
     rng = np.random.default_rng(4)
-    lo = np.where(np.isfinite(arm.lower), arm.lower, -math.pi)
-    hi = np.where(np.isfinite(arm.upper), arm.upper, math.pi)
+    lo, hi = sample_range(arm)
     always: set[str] | None = None
     for _ in range(8):
         touching = {pair for pair in contacts(lo + (hi - lo) * rng.random(arm.nv))
@@ -254,8 +260,7 @@ def _adapter(
     for rpy in ADAPTERS:
         urdf_xml = build_description(stock, _tool(spec, rpy), removed)
         arm = _arm(urdf_xml, chain, held, spec.name)
-        bounded = np.isfinite(arm.lower) & np.isfinite(arm.upper)
-        mid = (np.where(bounded, arm.lower, 0.0) + np.where(bounded, arm.upper, 0.0)) / 2.0
+        mid = _mid(arm)
         contacts = CollisionChecker(urdf_xml, arm.joint_names, mid, dict(held)).contacts
         words = f"roll {math.degrees(rpy[0]):g} pitch {math.degrees(rpy[1]):g} deg"
         try:
@@ -282,8 +287,7 @@ def _heights(arm: ArmModel, reach: float, gap: float) -> list[float]:
     """The start pose search's tool-tip heights: over the table (the URDF root's z = 0 plane) by a fraction of
     the reach; for an arm whose first joint stands higher than half its reach over the table (on a torso),
     where its tool can point down."""
-    bounded = np.isfinite(arm.lower) & np.isfinite(arm.upper)
-    mid = (np.where(bounded, arm.lower, 0.0) + np.where(bounded, arm.upper, 0.0)) / 2.0
+    mid = _mid(arm)
     first = arm.joint_names[0]
     shoulder = float(arm.frame_pose(mid, first).translation[2]) if arm.has_frame(first) else 0.0
     fractions = [reach * f for f in (0.2, 0.28, 0.36, 0.45)]
@@ -360,8 +364,7 @@ def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
         force = contact_force_for(spec.driver, geometry.contact_force_limit)
         log(f"[robot] demos' contact force with {spec.driver}: {force.limit:g} N ({force.comment()})")
     motions = demo_motions(geometry, approach=gap)
-    bounded = np.isfinite(arm.lower) & np.isfinite(arm.upper)
-    mid = (np.where(bounded, arm.lower, 0.0) + np.where(bounded, arm.upper, 0.0)) / 2.0
+    mid = _mid(arm)
     heights = _heights(arm, reach, gap)
     contacts: Callable[[Sequence[float] | np.ndarray], list[str]]
     contacts = CollisionChecker(urdf_xml, arm.joint_names, mid, dict(held)).contacts
