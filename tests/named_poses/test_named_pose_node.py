@@ -60,15 +60,17 @@ def test_unknown_pose_is_refused_with_the_known_names(stack):
 
 
 def _start_a_slow_contact_move() -> None:
-    """A compliant move slowly along -X (contact_control's ~status then says move_active)."""
+    """A compliant move slowly along -X (contact_control's ~status then says move_active): 2 mm/s for at most
+    60 mm, so it runs for 30 s. At 10 mm/s over 50 mm it ended after 5 s, before a node started on a loaded
+    machine asked its question (CI: the late node then rightly moved)."""
     import rospy
     from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
 
     req = ConfigureForceControlRequest()
     req.direction_control_laws.x.type = 3  # compliant move
     req.cart_impedance_params.damping.translational.x = 30.0
-    req.cart_impedance_params.max_cart_vel.set.linear.x = -0.01
-    req.cart_impedance_params.max_path_deviation.translation.x = 0.05
+    req.cart_impedance_params.max_cart_vel.set.linear.x = -0.002
+    req.cart_impedance_params.max_path_deviation.translation.x = 0.06
     assert rospy.ServiceProxy("/configure_cartesian_impedance", ConfigureForceControl)(req).success
 
 
@@ -109,6 +111,8 @@ def test_a_fresh_named_poses_node_refuses_during_a_contact_move_it_has_not_heard
         with run_node("named_poses", "named_pose_server", params=params, name="late_poses") as late:
             late.wait_for_service("/late_poses/move_to", timeout=30)
             answer = rospy.ServiceProxy("/late_poses/move_to", MoveToNamedPose)(name="home", speed_scale=1.0)
+            still = rospy.wait_for_message("/contact_control_node/status", ContactControlStatus, 5)
+            assert still.move_active, f"the contact move ended before the question: {still.message}"
             assert not answer.success and "a contact move is running" in answer.message, answer.message
     finally:
         rospy.ServiceProxy("/contact_control_node/stop", Trigger)()

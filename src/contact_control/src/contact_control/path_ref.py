@@ -2,10 +2,10 @@
 replay.
 
 V = v_ref + k e (+ F / b): `PathReference.error` gives, per control axis, the pose error e (reference minus
-end
-effector: position [m], rotation vector [rad]) and v_ref, both along the control axes. The reference is held
-for `timeout` after its stamp (its position extrapolated with its velocity for at most `extrapolate` s); an
-older one is lost, and the move ends (the replay stopped sending). No ROS here.
+end effector: position [m], rotation vector [rad]) and v_ref, both along the control axes. The reference is
+held for `timeout` after its stamp: for `extrapolate` s its position moves on with its velocity, then it
+stands still (no velocity fed forward); an older one is lost, and the move ends (the replay stopped
+sending). No ROS here.
 """
 
 from __future__ import annotations
@@ -71,8 +71,12 @@ class PathReference:
         if self._t is None or t - self._t > self.timeout:
             return False
         m = as_rows(T_fixed_eef)
-        dt = min(max(t - self._t, 0.0), self.extrapolate)
-        p, v, r = self._p, self._v, self._r
+        age = max(t - self._t, 0.0)
+        dt = min(age, self.extrapolate)
+        p, r = self._p, self._r
+        # Past `extrapolate` the reference stands still: fed forward on, its velocity carried the tool v / k
+        # past the last point (a stalled replay ran a UR3 12 mm past the L's corner).
+        v = self._v if age <= self.extrapolate else (0.0,) * 6
         e = [p[i] + v[i] * dt - m[i][3] for i in range(3)]
         # R_ref R_eef^T: the rotation still to go, in the fixed frame.
         rd = [[r[i][0] * m[j][0] + r[i][1] * m[j][1] + r[i][2] * m[j][2] for j in range(3)] for i in range(3)]
