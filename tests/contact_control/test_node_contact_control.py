@@ -433,30 +433,48 @@ def test_queued_publishing_mode_still_answers_each_push_with_a_follower_twist(ro
     params = {
         "~ft_in_topic": "wrench", "~velocity_out_topic": "ee_velocity", "~publish_synchronously": False,
         "~tare_on_startup": False, "~lp_filter_enabled": False, "~wrench_timeout": 0.5,
+        "~eef_frame": "base_link",  # no tf here: the torque's reference point must not need one
     }
     with run_node("contact_control", "contact_control_node", args=[f"__ns:={ns}"], params=params) as h:
         h.wait_for_service(f"{ns}/configure_cartesian_impedance")
         pub = ros_node.Publisher(f"{ns}/wrench", WrenchStamped, queue_size=10, tcp_nodelay=True)
         twists = Collector(f"{ns}/ee_velocity", TwistStamped)
+        status = Collector(f"{ns}/contact_control_node/status", ContactControlStatus)
+        msg = WrenchStamped()
+        msg.header.frame_id = "base_link"
+        streaming = threading.Event()
+
+        def sensor() -> None:  # streams at 100 Hz from before the law (a law with no data ends in 1 s)
+            rate = rospy.Rate(100)
+            while not streaming.is_set() and not rospy.is_shutdown():
+                msg.header.stamp = rospy.Time.now()
+                pub.publish(msg)
+                rate.sleep()
+
+        thread = threading.Thread(target=sensor, daemon=True)
         try:
             wait_until(lambda: pub.get_num_connections() > 0, 10, "the node to subscribe to the wrench")
+            thread.start()
+            wait_until(lambda: (status.last() or ContactControlStatus(safety=3)).safety == 0, 10,
+                       "the node to see the streamed wrench (status safety ok)")
             req = ConfigureForceControlRequest()
             req.direction_control_laws.z.type = 1  # follower
             req.cart_impedance_params.damping.translational.z = 30.0
             configure = rospy.ServiceProxy(f"{ns}/configure_cartesian_impedance", ConfigureForceControl)
             assert configure(req).success
-            msg = WrenchStamped()
-            msg.header.frame_id = "base_link"
             msg.wrench.force.z = -6.0
-
-            def pushed_down() -> bool:
-                msg.header.stamp = rospy.Time.now()
-                pub.publish(msg)
-                return any(m.twist.linear.z < -0.01 for m in list(twists.msgs))
-
-            wait_until(pushed_down, 10, "a downward twist for a downward push")
+            try:
+                wait_until(lambda: any(m.twist.linear.z < -0.01 for m in list(twists.msgs)), 10,
+                           "a downward twist for a downward push")
+            except AssertionError as err:
+                last = status.last()
+                raise AssertionError(f"{err}; status: {last.message if last else 'none'}") from None
             assert all(abs(m.twist.linear.x) < 1e-9 and m.twist.linear.z <= 0.0 for m in list(twists.msgs))
         finally:
+            streaming.set()
+            if thread.is_alive():
+                thread.join(timeout=5)
+            status.close()
             twists.close()
             pub.unregister()
 
