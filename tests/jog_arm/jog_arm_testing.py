@@ -63,6 +63,20 @@ PANDA = Robot(
     },
 )
 
+# 5 joints; its tip link `gripper` shares its name with the jaw's joint (held at 0). The default length
+# scale (0.4 m, twice its reach) puts every posture past 8 (generated packages measure their thresholds).
+SO100 = Robot(
+    "so100",
+    ROBOTS_DIR / "so_arm_description/urdf/so100.urdf",
+    "gripper",
+    "base",
+    (-0.87, 0.59, -0.79, 0.6, -1.5),  # 0.4 rad or more inside the limits
+    (-0.87, 0.59, -0.79, 0.6, -1.5),
+    0,
+    0.0,
+    {"singularity_length_scale": 0.2},
+)
+
 
 def make_jog(robot: Robot, **params: Any) -> JogCalcs:
     """A JogCalcs for `robot` with speed-unit commands at 100 Hz unless `params` says otherwise."""

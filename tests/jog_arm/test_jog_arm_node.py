@@ -16,7 +16,7 @@ from harness.bags import replay_bag, typestore, write_bag
 from harness.launch import run_launch, run_node
 from harness.streams import Repeater
 from harness.waiting import Collector, wait_until
-from jog_arm_testing import PANDA, UR5, angle_deg, ur5_launch_override
+from jog_arm_testing import PANDA, SO100, UR5, Robot, angle_deg, ur5_launch_override
 
 from jog_arm import ArmModel, StatusCode
 
@@ -260,11 +260,11 @@ def test_invalid_configuration_refuses_to_start(ros_node) -> None:
 
 
 @contextlib.contextmanager
-def ur5_server(rospy, name: str, prefix: str, params: dict, out_class: type):
-    """jog_arm_server for the UR5 at its start pose on `prefix` topics: yields (commands, twist sender)."""
+def ur5_server(rospy, name: str, prefix: str, params: dict, out_class: type, robot: Robot = UR5):
+    """jog_arm_server for `robot` at its start pose on `prefix` topics: yields (commands, twist sender)."""
     from sensor_msgs.msg import JointState
 
-    rospy.set_param("/robot_description", UR5.urdf)
+    rospy.set_param("/robot_description", robot.urdf)
     topics = {
         "joint_topic": f"{prefix}/joint_states",
         "cmd_in_topic": f"{prefix}/twist",
@@ -272,7 +272,7 @@ def ur5_server(rospy, name: str, prefix: str, params: dict, out_class: type):
     }
     set_params(rospy, name, {"command_in_type": "speed_units", **topics, **params})
     joints = rospy.Publisher(topics["joint_topic"], JointState, queue_size=1, latch=True)
-    state = JointState(name=list(ArmModel(UR5.urdf, UR5.tip).joint_names), position=list(UR5.start))
+    state = JointState(name=list(ArmModel(robot.urdf, robot.tip).joint_names), position=list(robot.start))
     driver = Repeater(joints).start(state, rate=100.0)  # a driver streams its state (joint_state_timeout)
     commands = Collector(topics["cmd_out_topic"], out_class)
     sender = Sender(rospy, topics["cmd_in_topic"])
@@ -376,3 +376,29 @@ def test_contact_controls_twists_pass_the_guard_and_others_do_not(ros_node) -> N
         laws.pub.unregister()
         pressing.stop()
         contact.unregister()
+
+
+def test_a_five_joint_arm_jogs_and_its_status_names_the_rotation_it_cannot_make(ros_node) -> None:
+    """The SO-100 (5 joints): a twist along X moves the tip along X, and the status carries the rotation
+    axis it cannot make (a unit vector of planning_frame) and says so."""
+    from compliant_control_msgs.msg import JogStatus
+    from std_msgs.msg import Float64MultiArray
+
+    params = {"ee_frame_name": SO100.tip, "planning_frame": SO100.planning_frame, "cmd_frame": "",
+              "command_out_type": "velocity_array", **SO100.params}
+    status = Collector("/jog_so100/status", JogStatus)
+    try:
+        with ur5_server(ros_node, "jog_so100", "/jog_five", params, Float64MultiArray, SO100) as (commands,
+                                                                                                sender):
+            sender.start(twist_msg((0.02, 0.0, 0.0, 0.0, 0.0, 0.0)))
+            commands.wait_for(20, timeout=10)
+            v = eef_velocity(ArmModel(SO100.urdf, SO100.tip), SO100.start, commands.last().data)
+            assert v[0] > 0.0 and abs(v[1]) < 0.05 * v[0] and abs(v[2]) < 0.05 * v[0]
+            wait_until(lambda: any(m.uncontrolled_rotations for m in list(status.msgs)), 10,
+                       "a status naming the uncontrolled rotation")
+            last = next(m for m in reversed(list(status.msgs)) if m.uncontrolled_rotations)
+            (axis,) = last.uncontrolled_rotations
+            assert math.isclose(math.hypot(axis.x, axis.y, axis.z), 1.0, rel_tol=1e-6)
+            assert "cannot turn about [" in last.message and "of base" in last.message, last.message
+    finally:
+        status.close()

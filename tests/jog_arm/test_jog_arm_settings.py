@@ -134,8 +134,8 @@ def test_model_refuses_bad_urdf() -> None:
 def test_jog_refuses_config_that_does_not_fit_the_model() -> None:
     with pytest.raises(KinematicsError, match="planning_frame"):
         make_jog(UR5, planning_frame="map")
-    with pytest.raises(KinematicsError, match="at least 6"):
-        make_jog(PANDA, joint_names=["panda_joint1", "panda_joint2", "panda_joint3"], joint_limits={})
+    with pytest.raises(KinematicsError, match="at least 3"):
+        make_jog(PANDA, joint_names=["panda_joint1", "panda_joint2"], joint_limits={})
     with pytest.raises(SettingsError, match="nullspace_posture"):
         make_jog(PANDA, nullspace_posture=[0.0, 0.0])
     with pytest.raises(KinematicsError, match="joint_limits/elbow"):

@@ -4,7 +4,9 @@ The Jacobian's linear rows are divided by ``singularity_length_scale`` so metres
 (twists given to this module are weighted the same way). Its singular values come from the eigenvalues of
 the 6x6 ``J·Jᵀ`` (eigenpy, a few µs); the condition number is the largest over the smallest (valid for 6 and
 7 joints, unlike the fork's eigenvalues of J itself). The damped pseudo-inverse ``J⁺ = Jᵀ(JJᵀ + λ²I)⁻¹`` is
-applied by a Cholesky solve, its λ growing as the smallest singular value falls.
+applied by a Cholesky solve, its λ growing as the smallest singular value falls. An arm with fewer than six
+joints cannot follow every twist: its singular values come from the n x n ``Jᵀ·J`` and the twist is solved
+translation first (`task_priority`).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from compliant_common.typedefs import FloatArray
 from jog_arm.kinematics import ArmModel
 from jog_arm.limits import singularity_scale
 from jog_arm.settings import JogSettings
+from jog_arm.task_priority import PriorityTask
 
 __all__ = ["DampedSolver", "Geometry"]
 
@@ -69,12 +72,15 @@ class DampedSolver:
         self._gain_posture = self._ns_gain * (np.zeros(n) if posture is None else posture)
         self._redundant = n > 6 and settings.nullspace_gain > 0.0
         self._inv_length = 1.0 / settings.singularity_length_scale
-        self._jjt = np.zeros((6, 6))
+        #: Fewer than six joints: the twist is solved translation first (None: 6 or more, J⁺ by Cholesky).
+        self.task = PriorityTask(n) if n < 6 else None
+        m = min(n, 6)  # the size of J·Jᵀ (Jᵀ·J with fewer than six joints)
+        self._jjt = np.zeros((m, m))
         self._displacement = np.zeros(6)
-        self._eig = eigenpy.SelfAdjointEigenSolver(6)
-        self._llt = eigenpy.LLT(6)
-        self._eye6 = np.eye(6)
-        self._eig_only = eigenpy.SelfAdjointEigenSolver(6)
+        self._eig = eigenpy.SelfAdjointEigenSolver(m)
+        self._llt = eigenpy.LLT(m)
+        self._eye6 = np.eye(m)
+        self._eig_only = eigenpy.SelfAdjointEigenSolver(m)
         #: The reference configuration of the last :meth:`geometry` (Pinocchio reads it; zeros before).
         self.q_arr = np.zeros(n)
         self._geom = Geometry()
@@ -110,15 +116,20 @@ class DampedSolver:
         # The eigenvalues of J·Jᵀ are the squared singular values (eigenpy: ~2 µs).
         J = self._model.jacobian(q_arr)
         J[:3] *= self._inv_length
-        A = np.dot(J, J.T, out=self._jjt)
+        task = self.task
+        A = np.dot(J, J.T, out=self._jjt) if task is None else np.dot(J.T, J, out=self._jjt)
         self._eig.compute(A, _EIGENVALUES_ONLY)
         sigma2 = self._eig.eigenvalues()  # ascending; a view, valid until the next compute
         s2_min, s2_max = float(sigma2[0]), float(sigma2[-1])
         # Damped pseudo-inverse J⁺ = Jᵀ(JJᵀ + λ²I)⁻¹: λ grows as the smallest singular value falls.
         s_min = math.sqrt(max(s2_min, 0.0))
+        damping2 = 0.0
         if s_min < self._damping_threshold:
             ratio = s_min / self._damping_threshold
-            A += self._eye6 * (self._damping2 * (1.0 - ratio * ratio) + _DAMPING_FLOOR)
+            damping2 = self._damping2 * (1.0 - ratio * ratio) + _DAMPING_FLOOR
+            A += self._eye6 * damping2
+        if task is not None:
+            task.update(J, damping2)
         llt = self._llt
         llt.compute(A)
         if llt.info() != eigenpy.ComputationInfo.Success:  # numerically singular: damp harder
@@ -135,6 +146,8 @@ class DampedSolver:
         the null-space pull toward the posture, scaled by `scale`:
         J⁺x + (I - J⁺J)·pull = J⁺(x - J·pull) + pull."""
         llt = self._llt
+        if self.task is not None:
+            return self.task.solve(x)
         if not self._redundant:
             solved: FloatArray = llt.solve(x)  # eigenpy: untyped
             return J.T @ solved
@@ -163,7 +176,7 @@ class DampedSolver:
         self._geom.valid = False
         J = self._model.jacobian(q + dq * (_PREDICTION_STEP / norm))  # a fresh array
         J[:3] *= self._inv_length
-        self._eig_only.compute(J @ J.T, _EIGENVALUES_ONLY)
+        self._eig_only.compute(J @ J.T if self.task is None else J.T @ J, _EIGENVALUES_ONLY)
         sigma2 = self._eig_only.eigenvalues()
         return math.sqrt(float(sigma2[-1]) / float(sigma2[0])) if sigma2[0] > 0.0 else math.inf
 
@@ -182,7 +195,8 @@ class DampedSolver:
         error = self._model.tip_displacement(g.q_arr, q_end, self._displacement)
         error[:3] *= self._inv_length
         error -= g.J @ dq_arr * period
-        correction = (g.J.T @ self._llt.solve(error)) / period
+        task = self.task
+        correction = (g.J.T @ self._llt.solve(error) if task is None else task.solve(error)) / period
         if np.max(np.abs(correction)) > _STRAIGHTEN_LIMIT * np.max(np.abs(dq_arr)):
             return dq  # not second order: a step too long for one Newton step to be right
         dq_arr -= correction

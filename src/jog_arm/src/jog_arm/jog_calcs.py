@@ -125,9 +125,9 @@ class JogCalcs:
             )
         model_names = self.model.joint_names
         n = self.nv = self.model.nv
-        if n < 6:
+        if n < 3:
             raise KinematicsError(
-                f"jog_arm needs at least 6 controlled joints to follow 6-D twists, got {list(model_names)}"
+                f"jog_arm needs at least 3 controlled joints to move the tip in 3-D, got {list(model_names)}"
             )
         #: Joint order of every array given to and returned by this class.
         self.joint_names: tuple[str, ...] = settings.joint_names or model_names
@@ -166,6 +166,10 @@ class JogCalcs:
         self._zero_sent = settings.num_outgoing_halt_msgs_to_publish  # silent until the first command
         self._zeros = (0.0,) * n
         self._condition = math.nan  # of the last Jacobian computed by a step
+        self._uncontrolled: tuple[list[float] | None, list[tuple[float, float, float]]] = (None, [])
+        self._planning_id = pid = self.model.frame_id(settings.planning_frame)
+        frame = self.model.model.frames[pid]  # its rotation in the root, if fixed to the root
+        self._planning_rotation = frame.placement.rotation.copy() if frame.parentJoint == 0 else None
 
     def retune(self, settings: JogSettings) -> None:
         """Live tuning (settings.TUNABLE, already validated): unitless scales, command timeout, twist filter
@@ -419,3 +423,21 @@ class JogCalcs:
         q = self.solver.q_arr.copy() if positions is None else self.joints.model_order(positions)
         self.solver.invalidate()  # frame_pose moves the model's data
         return self.model.frame_pose(q, self.settings.ee_frame_name, self.settings.planning_frame)
+
+    def uncontrolled_rotations(self) -> list[tuple[float, float, float]]:
+        """Unit axes of `planning_frame` the tip cannot turn about while its position is kept, at the next
+        step's reference configuration (an arm with fewer than six joints; empty with six or more, or before
+        the first joint state). Off the control path: the node asks when it publishes the status."""
+        task = self.solver.task
+        if task is None or not self.joints.received:
+            return []
+        q_ref = self._reference()[0]
+        if self._uncontrolled[0] != q_ref:
+            self.solver.geometry(q_ref)  # the task's factorisation at q_ref (reused by the next step)
+            planning = self._planning_rotation
+            if planning is None:  # a planning frame that moves with the joints
+                planning = self.model.frame_rotation(self._planning_id, self.solver.q_arr)
+                self.solver.invalidate()  # frame_rotation at q moves the model's data
+            axes = task.uncontrolled @ planning  # root axes -> planning_frame axes
+            self._uncontrolled = (list(q_ref), [(float(a), float(b), float(c)) for a, b, c in axes])
+        return self._uncontrolled[1]

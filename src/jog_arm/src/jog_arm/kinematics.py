@@ -88,6 +88,7 @@ class ArmModel:
                 )
         locked = [jid for jid in range(1, full.njoints) if full.names[jid] not in controlled]
         held = _held_configuration(full, controlled, held_positions or {})
+        _rename_clashing(full, locked)
         model = pin.buildReducedModel(full, locked, held) if locked else full
         self.model = model
         self.data = model.createData()
@@ -99,7 +100,7 @@ class ArmModel:
         # Kinematic order of the controlled joints: index i of every array in this class.
         self.joint_names: tuple[str, ...] = tuple(model.names[1:])
         self.tip_frame = tip_frame
-        self.tip_id = model.getFrameId(tip_frame)
+        self.tip_id = frame_index(model, tip_frame)
         self._tip_support = set(model.supports[model.frames[self.tip_id].parentJoint])
 
         # (q index, v index) of the 1-value joints and of the (cos, sin) continuous ones, model order.
@@ -200,8 +201,7 @@ class ArmModel:
         """
         if not self.has_frame(name):
             raise KinematicsError(f"{name!r} is not a frame of the robot model")
-        fid: int = self.model.getFrameId(name)  # pinocchio: untyped
-        return fid
+        return frame_index(self.model, name)
 
     def moves_with_tip_chain(self, frame_id: int) -> bool:
         """True if the frame's placement is refreshed by :meth:`jacobian` (root or on the tip's chain)."""
@@ -275,9 +275,34 @@ class ArmModel:
         return homogeneous
 
 
+def frame_index(model: pin.Model, name: str) -> int:
+    """Pinocchio id of the frame `name` (an existing one), the link's when a joint has the same name (the
+    SO-100's `gripper` is both: Pinocchio refuses to choose)."""
+    for kind in (pin.BODY, pin.OP_FRAME, pin.FIXED_JOINT, pin.JOINT, pin.SENSOR):
+        if model.existFrame(name, kind):
+            index: int = model.getFrameId(name, kind)  # pinocchio: untyped
+            return index
+    raise KinematicsError(f"{name!r} is not a frame of the robot model")
+
+
+def _rename_clashing(model: pin.Model, joints: Sequence[int]) -> None:
+    """Renames the given joints (and their frames) that share their name with a link: Pinocchio's reduction
+    looks their frames up by name and refuses to choose (the SO-100's `gripper` joint and link). They are
+    locked: nothing refers to them by name afterwards."""
+    for jid in joints:
+        name = model.names[jid]
+        if not model.existFrame(name, pin.BODY):
+            continue
+        for fid, frame in enumerate(model.frames):
+            if frame.name == name and frame.type == pin.JOINT:
+                frame.name = f"{name}#joint"
+                model.frames[fid] = frame
+        model.names[jid] = f"{name}#joint"
+
+
 def _chain_joints(model: pin.Model, tip_frame: str) -> list[str]:
     """Names of the joints from the root to `tip_frame` (checked for 1 DoF by the caller)."""
-    parent = model.frames[model.getFrameId(tip_frame)].parentJoint
+    parent = model.frames[frame_index(model, tip_frame)].parentJoint
     return [model.names[jid] for jid in model.supports[parent][1:]]
 
 

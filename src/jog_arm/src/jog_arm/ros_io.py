@@ -17,6 +17,7 @@ from compliant_common.live_params import LiveParams
 from compliant_common.ros_diagnostics import DiagnosticsPublisher
 from compliant_common.typedefs import ParamMap
 from compliant_control_msgs.msg import JogStatus
+from geometry_msgs.msg import Vector3
 from std_msgs.msg import Float64MultiArray
 from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
@@ -61,6 +62,7 @@ class JogArmRos:
             self._cmd_pub = rospy.Publisher(s.cmd_out_topic, Float64MultiArray, queue_size=queue,
                                             tcp_nodelay=True)
         self._status_msg = JogStatus()
+        self._under = stage.jog.nv < 6
         self._status_pub = rospy.Publisher(private_ns + "status", JogStatus, queue_size=100)
         self._services = [
             rospy.Service(private_ns + "pause", Trigger, self._on_pause),
@@ -78,6 +80,9 @@ class JogArmRos:
             len(stage.joint_names), stage.joint_names, s.ee_frame_name, rospy.resolve_name(s.cmd_in_topic),
             s.command_in_type, s.command_out_type, rospy.resolve_name(s.cmd_out_topic), s.pub_period,
         )
+        if self._under:
+            rospy.loginfo("jog_arm_server: fewer than 6 joints: translation first, rotations as far as "
+                          "the arm can; the status names the rotations it cannot make (README)")
 
     # --- out ---
     def publish(self, cycle: JogCycle | None) -> None:
@@ -92,6 +97,10 @@ class JogArmRos:
             msg.header.stamp = rospy.Time.from_sec(cycle.t)
             msg.code, msg.code_name, msg.message = int(cycle.status), cycle.status.name, cycle.message
             msg.condition_number, msg.speed_scale = cycle.condition, cycle.scale
+            if self._under:  # fewer than six joints: which rotations the twist cannot have (README)
+                axes = self._stage.jog.uncontrolled_rotations()
+                msg.uncontrolled_rotations = [Vector3(*axis) for axis in axes]
+                msg.message += "; " + _uncontrolled_text(axes, self._s.planning_frame)
             self._status_pub.publish(msg)
         if cycle.status_changed:
             level = log_level(cycle.status)
@@ -236,3 +245,10 @@ def load(params: ParamMap, urdf_xml: str | None, prefix: str) -> tuple[JogSettin
     if not urdf_xml:
         raise SettingsError("robot_description parameter is missing or empty: load the URDF first")
     return settings, warnings
+
+
+def _uncontrolled_text(axes: list[tuple[float, float, float]], frame: str) -> str:
+    """'cannot turn about [+0.00 +1.00 +0.00] of base_link (5 joints: translation first)'."""
+    named = " or ".join("[" + " ".join(f"{c:+.2f}" for c in axis) + "]" for axis in axes)
+    return f"cannot turn about {named} of {frame} (fewer than 6 joints: translation first)" if axes else \
+        "fewer than 6 joints: translation first"
