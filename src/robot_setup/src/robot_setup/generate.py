@@ -73,7 +73,7 @@ TOOL_COM = (0.0, 0.0, 0.05)  # [m] in the sensor frame
 # Servo gain per newton-metre of the URDF's joint effort, capped (stiff like an industrial controller).
 KP_PER_NM, KP_MAX, KP_MIN = 120.0, 20000.0, 1000.0
 KV_RATIO = 0.02  # kv = kp * this [s]
-MIN_JOINTS = 6  # jog_arm's JogCalcs refuses fewer (it follows 6-D twists)
+MIN_JOINTS = 6  # jog_arm jogs 3 to 5 (translation first); the start pose search and demos need 6 so far
 
 
 class GeneratorError(StackError):
@@ -336,9 +336,9 @@ def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
     arm = _arm(urdf_xml, chain, held, name)
     if arm.nv < MIN_JOINTS:
         raise GeneratorError(
-            f"{arm.nv} joints between {base} and {spec.tip} ({', '.join(arm.joint_names)}): jog_arm follows "
-            f"6-D twists and needs {MIN_JOINTS} or more; arms with fewer are not supported yet (robot_setup "
-            "README)"
+            f"{arm.nv} joints between {base} and {spec.tip} ({', '.join(arm.joint_names)}): jog_arm jogs "
+            f"arms with fewer than 6 (translation first), but make robot's start pose search and "
+            f"demonstrations need {MIN_JOINTS} or more so far (robot_setup README)"
         )
     reach = estimate_reach(arm)
     log(f"[robot] {spec.name}: {arm.nv} joints {list(arm.joint_names)}, tool-tip reach ~{reach:.2f} m")
