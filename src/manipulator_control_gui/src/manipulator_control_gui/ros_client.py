@@ -257,6 +257,7 @@ class ContactControlClient:
                on_done: Callable[[CallResult], None]) -> None:
         """Sends a replay goal (teach's ~replay action); `on_done` gets its result when it ends."""
         import actionlib
+        from compliant_common.goal_call import GoalCall
         from compliant_control_msgs.msg import ReplayProgramAction, ReplayProgramGoal
 
         rospy = self._rospy
@@ -264,20 +265,20 @@ class ContactControlClient:
         def run() -> None:
             client = self._replay_client
             if client is None:
-                client = self._replay_client = actionlib.SimpleActionClient(
+                client = self._replay_client = actionlib.ActionClient(
                     self.resolved.teach_node + "/replay", ReplayProgramAction)
             if not client.wait_for_server(rospy.Duration(2.0)):
                 where = self.resolved.teach_node + "/replay"
                 on_done(CallResult(False, message=f"{where} is not available (is program_server running?)"))
                 return
 
-            def done(_state: int, result: Any) -> None:
+            def done(result: Any) -> None:
                 if result is None:
                     on_done(CallResult(False, message="the replay ended without a result"))
                 else:
                     on_done(CallResult(True, bool(result.success), None, str(result.message)))
 
-            client.send_goal(ReplayProgramGoal(name=name, speed=speed, press_axis=press_axis,
+            GoalCall(client, ReplayProgramGoal(name=name, speed=speed, press_axis=press_axis,
                                                press_force=press_force), done_cb=done)
 
         threading.Thread(target=run, name="mcg-replay", daemon=True).start()

@@ -53,7 +53,8 @@ def _replay(args: argparse.Namespace, node: str) -> int:
     """Sends the goal, prints the feedback twice a second and the result; Ctrl-C cancels."""
     import actionlib
     import rospy
-    from compliant_control_msgs.msg import ReplayProgramAction, ReplayProgramGoal
+    from compliant_common.goal_call import GoalCall
+    from compliant_control_msgs.msg import ReplayProgramAction, ReplayProgramGoal, ReplayProgramResult
 
     press = [(axis, getattr(args, f"press_{axis}")) for axis in ("x", "y", "z")
              if getattr(args, f"press_{axis}") is not None]
@@ -61,7 +62,7 @@ def _replay(args: argparse.Namespace, node: str) -> int:
         print("teach: press along one axis at most", file=sys.stderr)
         return 2
     axis, force = press[0] if press else ("", 0.0)
-    client = actionlib.SimpleActionClient(f"{node}/replay", ReplayProgramAction)
+    client = actionlib.ActionClient(f"{node}/replay", ReplayProgramAction)
     if not client.wait_for_server(rospy.Duration(5.0)):
         print(f"teach: {node}/replay: no action server (is the stack running?)", file=sys.stderr)
         return 1
@@ -74,14 +75,15 @@ def _replay(args: argparse.Namespace, node: str) -> int:
             print(f"{fb.state}: {fb.progress:.0%}, path error {fb.path_error * 1e3:.1f} mm, "  # type: ignore[attr-defined]
                   f"force {fb.force:.1f} N", flush=True)  # type: ignore[attr-defined]
 
-    client.send_goal(ReplayProgramGoal(name=args.name, speed=args.speed, press_axis=axis, press_force=force),
-                     feedback_cb=feedback)
+    goal = ReplayProgramGoal(name=args.name, speed=args.speed, press_axis=axis, press_force=force)
+    call: GoalCall[object, ReplayProgramResult] = GoalCall(client, goal, feedback_cb=feedback)
     try:
-        client.wait_for_result()
+        while not call.wait(0.5) and not rospy.is_shutdown():  # waits in slices: Ctrl-C gets through
+            pass
     except KeyboardInterrupt:
-        client.cancel_goal()
-        client.wait_for_result(rospy.Duration(10.0))
-    result = client.get_result()
+        call.cancel()
+        call.wait(10.0)
+    result = call.result()
     if result is None:
         print("teach: no result from the replay", file=sys.stderr)
         return 1

@@ -16,7 +16,13 @@ from typing import TYPE_CHECKING
 import actionlib
 import numpy as np
 import rospy
-from compliant_control_msgs.msg import ReplayProgramAction, ReplayProgramFeedback, ReplayProgramGoal
+from compliant_common.goal_call import GoalCall
+from compliant_control_msgs.msg import (
+    ReplayProgramAction,
+    ReplayProgramFeedback,
+    ReplayProgramGoal,
+    ReplayProgramResult,
+)
 from compliant_control_msgs.srv import Guide, PushEEFRequest, RecordProgram
 from std_srvs.srv import Trigger
 
@@ -61,7 +67,7 @@ class TeachFlow:
         self._record = rospy.ServiceProxy(f"{teach}/record", RecordProgram)
         self._stop_recording = rospy.ServiceProxy(f"{teach}/stop", Trigger)
         self._guide = rospy.ServiceProxy(f"{cc}/guide", Guide)
-        self._replay = actionlib.SimpleActionClient(f"{teach}/replay", ReplayProgramAction)
+        self._replay = actionlib.ActionClient(f"{teach}/replay", ReplayProgramAction)
         if not self._replay.wait_for_server(rospy.Duration(timeout)):
             raise RuntimeError(f"no {teach}/replay action server")
 
@@ -131,14 +137,16 @@ class TeachFlow:
         goal = ReplayProgramGoal(
             name=PROGRAM, speed=speed, press_axis="z" if press else "", press_force=target if press else 0.0
         )
-        self._replay.send_goal(goal, feedback_cb=on_feedback)
-        if not self._replay.wait_for_result(rospy.Duration(REPLAY_TIMEOUT)):
-            self._replay.cancel_goal()
-            self._replay.wait_for_result(rospy.Duration(10.0))
-            result = self._replay.get_result()
+        call: GoalCall[ReplayProgramFeedback, ReplayProgramResult] = GoalCall(self._replay, goal, on_feedback)
+        if not call.wait(REPLAY_TIMEOUT):
+            call.cancel()
+            call.wait(10.0)
+            result = call.result()
             message = f"no result within {REPLAY_TIMEOUT:g} s" + (f" ({result.message})" if result else "")
             return Replayed(label, speed, press, False, message, math.nan, math.nan, start=start)
-        result = self._replay.get_result()
+        result = call.result()
+        if result is None:  # not after a finished wait; for the type checker
+            return Replayed(label, speed, press, False, "no result", math.nan, math.nan, start=start)
         print(f"  {label}: {result.message}", flush=True)
         return Replayed(
             label,
