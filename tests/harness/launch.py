@@ -15,6 +15,10 @@ from harness.waiting import wait_until
 __all__ = ["Launched", "run_launch", "run_node"]
 
 
+class _ExitedError(AssertionError):
+    """The process died while waited for (its output is in the message already)."""
+
+
 class Launched:
     """A launched process group with helpers to wait on what it should offer."""
 
@@ -32,7 +36,7 @@ class Launched:
 
     def _check_alive(self) -> None:
         if self.proc.poll() is not None:
-            raise AssertionError(f"process exited with {self.proc.returncode}:\n{self.output()[-4000:]}")
+            raise _ExitedError(f"process exited with {self.proc.returncode}:\n{self.output()[-4000:]}")
 
     def wait_for_topic(self, name: str, timeout: float = 20.0) -> None:
         """Waits until some node publishes `name`."""
@@ -42,7 +46,12 @@ class Launched:
             _, _, topics = self._master().getPublishedTopics("/harness", "")
             return any(topic == name for topic, _ in topics)
 
-        wait_until(published, timeout, f"topic {name} to be published\n{self.output()[-4000:]}")
+        try:
+            wait_until(published, timeout, f"topic {name} to be published")
+        except _ExitedError:
+            raise
+        except AssertionError as err:  # the output when it failed, not when the wait began
+            raise AssertionError(f"{err}\n{self.output()[-4000:]}") from None
 
     def wait_for_service(self, name: str, timeout: float = 20.0) -> None:
         """Waits until service `name` is registered with the master."""
@@ -52,7 +61,12 @@ class Launched:
             code, _, _ = self._master().lookupService("/harness", name)
             return code == 1
 
-        wait_until(registered, timeout, f"service {name}\n{self.output()[-4000:]}")
+        try:
+            wait_until(registered, timeout, f"service {name}")
+        except _ExitedError:
+            raise
+        except AssertionError as err:  # the output when it failed, not when the wait began (empty then)
+            raise AssertionError(f"{err}\n{self.output()[-4000:]}") from None
 
     def stop(self, timeout: float = 15.0) -> None:
         stop_process_group(self.proc, timeout)
