@@ -383,6 +383,8 @@ def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
     q0 = np.round(found.q, 4)  # what the files say, analysed again as written
     start = analyse_pose(arm, q0, motions, contacts=contacts)
     tip = start.tip
+    x, y, z = (float(v) for v in arm.frame_pose(q0, arm.tip_frame, base).translation)
+    tip_in_base = (x, y, z)
     worst = start.worst_condition
     threshold = max(6.0, math.ceil(worst * 1.2 * 2.0) / 2.0)
     hard_stop = float(max(12.0, math.ceil(threshold * 1.5)))
@@ -410,7 +412,8 @@ def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
         spec=spec, source=source, removed=removed, base=base, tool_rpy=rpy, adapter=adapter, held=held,
         servo_joints=servo_joints, urdf_xml=urdf_xml, joints=arm.joint_names,
         reach=reach, geometry=geometry, gap=gap, obstacle_size=obstacle_size,
-        obstacle_position=obstacle_position, start=start, home=home, threshold=threshold, hard_stop=hard_stop,
+        obstacle_position=obstacle_position, start=start, tip_in_base=tip_in_base, home=home,
+        threshold=threshold, hard_stop=hard_stop,
         kp=kp, kv=kv, armature=armature, efforts=tuple(efforts), driver=driver,
     )
     for line in analysis_lines(plan, arm):
@@ -424,8 +427,9 @@ def analysis_lines(plan: Plan, arm: ArmModel | None = None) -> list[str]:
     finite = [(n, m) for n, m in zip(plan.joints, s.margins, strict=True) if math.isfinite(m)]
     closest = min(finite, key=lambda nm: nm[1]) if finite else ("(all continuous)", math.inf)
     lines = [
-        f"start pose: tool pointing down, tool tip at ({s.tip[0]:.3f}, {s.tip[1]:.3f}, {s.tip[2]:.3f}) m in "
-        f"{plan.base}; condition number {s.condition:.2f} (length scale {LENGTH_SCALE} m)",
+        f"start pose: tool pointing down, tool tip at ({plan.tip_in_base[0]:.3f}, {plan.tip_in_base[1]:.3f}, "
+        f"{plan.tip_in_base[2]:.3f}) m in {plan.base}; condition number {s.condition:.2f} (length scale "
+        f"{LENGTH_SCALE} m)",
         f"joint-limit margin at the start pose {closest[1]:.2f} rad ({closest[0]}), at least "
         f"{s.min_margin:.2f} rad "
         "on the demos' motions",

@@ -124,6 +124,7 @@ class Plan:
     obstacle_size: tuple[float, float, float]
     obstacle_position: tuple[float, float, float]
     start: PoseReport
+    tip_in_base: tuple[float, float, float]  # the start pose's tool tip in `base` (start.tip: URDF root)
     home: np.ndarray
     threshold: float
     hard_stop: float
