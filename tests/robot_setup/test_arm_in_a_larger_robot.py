@@ -107,3 +107,17 @@ def test_a_file_that_is_not_a_urdf_is_refused_in_one_line(tmp_path, capsys):
     assert main(["--name", "t", "--urdf", str(bad), "--tip", "a", "--src", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("make robot: error: the URDF is not XML: "), err
+
+
+def test_a_straight_mounting_near_a_singularity_gets_an_adapter_that_does_better():
+    """The UR3 with its tool on ee_link (whose z is across the flange): straight, the demos reach condition
+    number 21.6 and touching the block overshot to 26 N; make robot tries the adapters and puts the tool along
+    the flange's axis (pitch 90 deg), as on tool0. A user's TOOL_RPY is kept as given."""
+    lines: list[str] = []
+    urdf = "ur_description/urdf/ur3_gripper.urdf"
+    plan = plan_robot(RobotSpec("g", urdf, "ee_link"), log=lines.append)
+    assert plan.tool_rpy == pytest.approx((0.0, math.pi / 2, 0.0))
+    assert plan.start.worst_condition < 15.0 and "reached condition number 21.6" in plan.adapter
+    assert any("trying adapter angles" in line for line in lines)
+    given = plan_robot(RobotSpec("g", urdf, "ee_link", tool_rpy=(0.0, 0.0, 0.0)), log=_quiet)
+    assert given.tool_rpy == (0.0, 0.0, 0.0) and given.adapter == "" and given.start.worst_condition > 15.0

@@ -68,6 +68,10 @@ __all__ = ["GeneratorError", "Plan", "RobotSpec", "command_line", "main", "plan_
 # (0.30 m hybrid travel, obstacle 7 cm below the tip); shorter arms get them scaled by reach / this. The
 # thesis's two arms, with the 0.12 m tool, reach 0.96 and 1.01 m measured this way (tests/robot_setup).
 REFERENCE_REACH = 0.9
+# A straight mounting whose demos reach a worse condition number than this has the adapters tried too (the
+# UR3's ee_link, whose z is across the flange: 21.6, its touching on the block overshot to 26 N and tripped
+# the 25 N global limit; the UR3 on tool0 13.2, the Jaco2 5.4, left as they were).
+POOR_CONDITION = 15.0
 TOOL_SIZE = (0.03, 0.12)  # [m] cylinder radius, length: the hand-written packages' tool
 TOOL_COM = (0.0, 0.0, 0.05)  # [m] in the sensor frame
 # Servo gain per newton-metre of the URDF's joint effort, capped (stiff like an industrial controller).
@@ -277,10 +281,12 @@ def _adapter(
     if best is None:
         raise GeneratorError(f"{straight}; nor with the sensor on an adapter at 45 or 90 degrees about the "
                              "flange's x or y axis: give the mounting with TOOL_RPY=roll,pitch,yaw")
-    rpy = best[1][0]
-    log(f"[robot] adapter chosen: TOOL_RPY={','.join(f'{v:.10g}' for v in rpy)} (roll "
-        f"{math.degrees(rpy[0]):g}, pitch {math.degrees(rpy[1]):g} deg), into config/description.args")
     return best[1]
+
+
+def _chosen(rpy: Sequence[float]) -> str:
+    return (f"[robot] adapter chosen: TOOL_RPY={','.join(f'{v:.10g}' for v in rpy)} (roll "
+            f"{math.degrees(rpy[0]):g}, pitch {math.degrees(rpy[1]):g} deg), into config/description.args")
 
 
 def _heights(arm: ArmModel, reach: float, gap: float) -> list[float]:
@@ -378,8 +384,25 @@ def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
         mounted = _adapter(stock, spec, removed, chain, held, reach, motions, gap,
                            f"straight on {spec.tip}: {exc}", log)
         rpy, urdf_xml, arm, contacts, found = mounted
+        log(_chosen(rpy))
         adapter = (f"an adapter make robot chose: the straight mounting had no tool-down start pose, this "
                    f"angle keeps the most margin ({found.min_margin:.2f} rad)")
+    else:
+        if spec.tool_rpy is None and found.worst_condition > POOR_CONDITION:
+            straight = found.worst_condition
+            log(f"[robot] the straight mounting's demos reach condition number {straight:.2f} (over "
+                f"{POOR_CONDITION:g}); trying adapter angles")
+            try:
+                better = _adapter(stock, spec, removed, chain, held, reach, motions, gap, "", log)
+            except GeneratorError:
+                better = None
+            if better is not None and better[4].worst_condition < straight:
+                rpy, urdf_xml, arm, contacts, found = better
+                log(_chosen(rpy))
+                adapter = (f"an adapter make robot chose: the straight mounting's demos reached condition "
+                           f"number {straight:.2f}, this angle's {found.worst_condition:.2f}")
+            else:
+                log("[robot] straight kept: no adapter angle does better")
     q0 = np.round(found.q, 4)  # what the files say, analysed again as written
     start = analyse_pose(arm, q0, motions, contacts=contacts)
     tip = start.tip
