@@ -94,6 +94,30 @@ def test_run_node_starts_and_stops_a_real_node(ros_node):
     assert node.proc.poll() is not None, "node stopped when the context ended"
 
 
+def test_a_killed_node_leaves_nothing_registered_for_the_next_one(ros_node):
+    """A node killed before it could unregister (SIGKILL after the stop timeout) is cleaned from the master
+    when its context ends (`rosnode cleanup`): left there, its name and API made the master shut down a later
+    node that got the same port (a panda replay test's named_poses died so)."""
+    import os
+    import signal
+    import xmlrpc.client
+
+    master = xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"])
+
+    def registered() -> set[str]:
+        state = master.getSystemState("/test")[2]
+        return {node for kind in state for _name, nodes in kind for node in nodes}
+
+    with run_node("rostopic", "rostopic", args=["pub", "-r", "10", "/harness_killed", "std_msgs/Empty"],
+                  name="harness_killed") as node:
+        node.wait_for_topic("/harness_killed", timeout=20)
+        os.killpg(node.proc.pid, signal.SIGKILL)
+        node.proc.wait()
+        assert "/harness_killed" in registered()  # what the master keeps of a killed node
+    assert "/harness_killed" not in registered()
+    assert master.lookupNode("/test", "/harness_killed")[0] != 1
+
+
 def test_launch_waits_report_a_missing_topic(ros_node):
     identity = ["0", "0", "0", "0", "0", "0", "a", "b"]
     with run_node("tf2_ros", "static_transform_publisher", args=identity) as node:

@@ -75,6 +75,7 @@ class Launched:
 @contextlib.contextmanager
 def _spawn(cmd: Sequence[str], env: Mapping[str, str] | None) -> Iterator[Launched]:
     log = tempfile.NamedTemporaryFile(prefix="harness_", suffix=".log", delete=False)
+    before = _registered_nodes()
     proc = subprocess.Popen(
         list(cmd),
         env=dict(os.environ if env is None else env),
@@ -88,8 +89,43 @@ def _spawn(cmd: Sequence[str], env: Mapping[str, str] | None) -> Iterator[Launch
         yield launched
     finally:
         launched.stop()
+        _forget_dead_nodes(before)
         log.close()
         os.unlink(log.name)
+
+
+def _registered_nodes(state: list | None = None) -> set[str]:
+    """Every node the master (or `state`, its getSystemState) has a publisher, subscriber or service of."""
+    if state is None:
+        master = xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"])
+        _code, _msg, state = master.getSystemState("/harness")
+    return {node for kind in state for _name, nodes in kind for node in nodes}
+
+
+def _forget_dead_nodes(before: set[str]) -> None:
+    """Unregisters what the stopped process's nodes left with the master (`rosnode cleanup`). A node killed
+    before it unregistered (SIGKILL after the stop timeout) stays registered under its name and API; when the
+    next test's node of that name registers, the master sends "new node registered with same name" to the
+    old API, and a new node that got the same port from the OS is the one shut down (a panda replay test's
+    named_poses died that way: control_stack's stale API was its port)."""
+    master = xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"])
+    _code, _msg, state = master.getSystemState("/harness")
+    publishers, subscribers, services = state
+    for node in _registered_nodes(state) - before:
+        code, _msg, api = master.lookupNode("/harness", node)
+        if code != 1:
+            continue
+        for topic, nodes in publishers:
+            if node in nodes:
+                master.unregisterPublisher(node, topic, api)
+        for topic, nodes in subscribers:
+            if node in nodes:
+                master.unregisterSubscriber(node, topic, api)
+        for service, nodes in services:
+            if node in nodes:
+                code, _msg, service_api = master.lookupService("/harness", service)
+                if code == 1:
+                    master.unregisterService(node, service, service_api)
 
 
 @contextlib.contextmanager

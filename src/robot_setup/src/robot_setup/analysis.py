@@ -44,6 +44,10 @@ __all__ = [
 DOWN = np.diag([1.0, -1.0, -1.0])
 LENGTH_SCALE = JogSettings.singularity_length_scale  # [m] jog_arm's default
 IK_TOLERANCE = 1e-6  # [m, rad] a pose counts as reached below this error
+# With a free yaw, at a tool-down pose the 5-joint SO-100 has one joint fewer than constraints to first
+# order (pan, lift, elbow, flex for the position and the axis; the roll turns about it), so the last microns
+# converge slowly (6e-6 after 400 iterations). The start pose is written to 1e-4 rad anyway.
+IK_TOLERANCE_FREE_YAW = 1e-4
 # solve_ik gives up when STALL_ITERATIONS iterations left the error above STALL_ERROR and above STALL_RATIO of
 # what it was (generating the UR3's and the Jaco2's packages gives the same files with and without this).
 STALL_ITERATIONS, STALL_RATIO, STALL_ERROR = 20, 0.5, 1e-3
@@ -80,10 +84,23 @@ def lowest_joint(arm: ArmModel, q: np.ndarray) -> float:
 
 
 def _pose_error(arm: ArmModel, q: np.ndarray, goal: pin.SE3) -> np.ndarray:
-    """(position error, rotation error) in base axes, 6-vector, goal minus current."""
-    now = arm.frame_pose(q, arm.tip_frame)
-    rot = pin.log3(goal.rotation @ now.rotation.T)
-    return np.concatenate([goal.translation - now.translation, rot])
+    """(position error, rotation error) in base axes, 6-vector, goal minus current; with fewer than six
+    joints the rotation about the goal's tool axis is free (`_error`)."""
+    return _error(arm.frame_pose(q, arm.tip_frame), goal, arm.nv < 6)
+
+
+def _error(tip: pin.SE3, goal: pin.SE3, free_yaw: bool) -> np.ndarray:
+    """Goal minus `tip`: translation, then rotation vector. `free_yaw`: only the rotation that turns the tool
+    axis (z) onto the goal's, so the turn about that axis is left free (an arm with fewer than six joints
+    points its tool down with whatever yaw its joints give)."""
+    if not free_yaw:
+        return np.concatenate([goal.translation - tip.translation, pin.log3(goal.rotation @ tip.rotation.T)])
+    now, want = tip.rotation[:, 2], goal.rotation[:, 2]
+    axis = np.cross(now, want)
+    sin, cos = float(np.linalg.norm(axis)), float(now @ want)
+    angle = math.atan2(sin, cos)
+    rot = axis * (angle / sin) if sin > 1e-12 else np.zeros(3)
+    return np.concatenate([goal.translation - tip.translation, rot])
 
 
 def solve_ik(
@@ -91,18 +108,26 @@ def solve_ik(
 ) -> np.ndarray | None:
     """Damped least-squares IK of the tool tip to `goal`, joints kept `limit_margin` inside their limits.
 
+    With fewer than six joints the tool's turn about its axis (z) is free: position and tool axis only.
+
     Returns:
         The joint angles (one per joint, model order), or None if it did not converge.
     """
     q = np.array(seed, dtype=float)
     lo, hi = arm.lower + limit_margin, arm.upper - limit_margin
     earlier = math.inf
+    free_yaw = arm.nv < 6
+    tolerance = IK_TOLERANCE_FREE_YAW if free_yaw else IK_TOLERANCE
+    if free_yaw:  # the Jacobian's rotation rows without the turn about the goal's tool axis
+        axis = goal.rotation[:, 2]
+        plane = np.eye(3) - np.outer(axis, axis)
     for i in range(iterations):
         jac = arm.jacobian(q)  # also places the tip frame: one kinematics pass per iteration
-        tip = arm.data.oMf[arm.tip_id]
-        err = np.concatenate([goal.translation - tip.translation, pin.log3(goal.rotation @ tip.rotation.T)])
+        err = _error(arm.data.oMf[arm.tip_id], goal, free_yaw)
+        if free_yaw:
+            jac[3:] = plane @ jac[3:]
         norm = float(np.linalg.norm(err))
-        if norm < IK_TOLERANCE:
+        if norm < tolerance:
             return q
         if i % STALL_ITERATIONS == 0:
             # Stuck (against a limit, or at a goal out of reach): a converging solve gains far more than
@@ -116,7 +141,7 @@ def solve_ik(
         if biggest > 0.5:  # far from the goal: no wild jumps across branches
             step *= 0.5 / biggest
         q = np.minimum(np.maximum(q + step, lo), hi)
-    return q if float(np.linalg.norm(_pose_error(arm, q, goal))) < IK_TOLERANCE else None
+    return q if float(np.linalg.norm(_pose_error(arm, q, goal))) < tolerance else None
 
 
 _EYE6 = np.eye(6)
@@ -362,7 +387,7 @@ def find_start_pose(
     heights = list(heights) if heights is not None else [reach * f for f in (0.2, 0.28, 0.36, 0.45)]
     xs = [reach * f for f in (0.45, 0.55, 0.4, 0.62, 0.35, 0.7)]
     ys = [0.0, 0.08 * reach, -0.08 * reach, 0.15 * reach, -0.15 * reach]
-    yaws = [0.0, math.pi / 2, math.pi, -math.pi / 2]
+    yaws = [0.0, math.pi / 2, math.pi, -math.pi / 2] if arm.nv >= 6 else [0.0]  # fewer: yaw is free
     seeds = _seeds(arm)
     best: tuple[float, PoseReport] | None = None
     closest: tuple[float, PoseReport] | None = None
