@@ -75,7 +75,8 @@ class Launched:
 @contextlib.contextmanager
 def _spawn(cmd: Sequence[str], env: Mapping[str, str] | None) -> Iterator[Launched]:
     log = tempfile.NamedTemporaryFile(prefix="harness_", suffix=".log", delete=False)
-    before = _registered_nodes()
+    uri = dict(os.environ if env is None else env).get("ROS_MASTER_URI")
+    before = _registered_nodes(_system_state(uri))
     proc = subprocess.Popen(
         list(cmd),
         env=dict(os.environ if env is None else env),
@@ -89,27 +90,37 @@ def _spawn(cmd: Sequence[str], env: Mapping[str, str] | None) -> Iterator[Launch
         yield launched
     finally:
         launched.stop()
-        _forget_dead_nodes(before)
+        _forget_dead_nodes(uri, before)
         log.close()
         os.unlink(log.name)
 
 
-def _registered_nodes(state: list | None = None) -> set[str]:
-    """Every node the master (or `state`, its getSystemState) has a publisher, subscriber or service of."""
-    if state is None:
-        master = xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"])
-        _code, _msg, state = master.getSystemState("/harness")
-    return {node for kind in state for _name, nodes in kind for node in nodes}
+def _system_state(uri: str | None) -> list | None:
+    """The master's getSystemState at `uri`; None without one (no master yet, or a test's fake one)."""
+    if not uri:
+        return None
+    try:
+        code, _msg, state = xmlrpc.client.ServerProxy(uri).getSystemState("/harness")
+    except (OSError, xmlrpc.client.Error):
+        return None
+    return state if code == 1 else None
 
 
-def _forget_dead_nodes(before: set[str]) -> None:
+def _registered_nodes(state: list | None) -> set[str]:
+    """Every node `state` (getSystemState) has a publisher, subscriber or service of."""
+    return {node for kind in state or () for _name, nodes in kind for node in nodes}
+
+
+def _forget_dead_nodes(uri: str | None, before: set[str]) -> None:
     """Unregisters what the stopped process's nodes left with the master (`rosnode cleanup`). A node killed
     before it unregistered (SIGKILL after the stop timeout) stays registered under its name and API; when the
     next test's node of that name registers, the master sends "new node registered with same name" to the
     old API, and a new node that got the same port from the OS is the one shut down (a panda replay test's
     named_poses died that way: control_stack's stale API was its port)."""
-    master = xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"])
-    _code, _msg, state = master.getSystemState("/harness")
+    state = _system_state(uri)
+    if state is None or uri is None:
+        return
+    master = xmlrpc.client.ServerProxy(uri)
     publishers, subscribers, services = state
     for node in _registered_nodes(state) - before:
         code, _msg, api = master.lookupNode("/harness", node)
