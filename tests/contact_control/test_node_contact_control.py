@@ -424,6 +424,52 @@ def test_config_file_documents_every_parameter_with_its_default():
     assert load_settings(data) == load_settings({})
 
 
+def test_a_status_after_stop_says_the_move_ended_before_the_next_wrench(ros_node):
+    """~stop answered, the next status says no move, even when no wrench has come since (the cycle that would
+    update the last result waits for one): teach refused a replay right after hand-guiding was switched off,
+    "a contact move is running", from a status made between the stop and the next wrench."""
+    import rospy
+    from cartesian_impedance_msgs.srv import ConfigureForceControlRequest
+
+    ns = "/cc_stop_status"
+    params = {"~ft_in_topic": "wrench", "~velocity_out_topic": "ee_velocity", "~tare_on_startup": False,
+              "~wrench_timeout": 20.0, "~no_data_end_timeout": 30.0, "~eef_frame": "base_link",
+              "~status_rate": 50.0}
+    with run_node("contact_control", "contact_control_node", args=[f"__ns:={ns}"], params=params) as h:
+        h.wait_for_service(f"{ns}/configure_cartesian_impedance")
+        pub = ros_node.Publisher(f"{ns}/wrench", WrenchStamped, queue_size=10, tcp_nodelay=True)
+        status = Collector(f"{ns}/contact_control_node/status", ContactControlStatus)
+        try:
+            wait_until(lambda: pub.get_num_connections() > 0, 10, "the node to subscribe to the wrench")
+            msg = WrenchStamped()
+            msg.header.frame_id = "base_link"
+
+            def one_wrench() -> bool:
+                msg.header.stamp = rospy.Time.now()
+                pub.publish(msg)
+                last = status.last()
+                return last is not None and last.safety == 0
+
+            wait_until(one_wrench, 10, "a wrench seen (status safety ok)")
+            req = ConfigureForceControlRequest()
+            req.direction_control_laws.z.type = 1  # follower
+            req.cart_impedance_params.damping.translational.z = 30.0
+            configure = rospy.ServiceProxy(f"{ns}/configure_cartesian_impedance", ConfigureForceControl)
+            assert configure(req).success
+            one_wrench()  # one cycle with the move: no wrench after this one
+            wait_until(lambda: (status.last() or ContactControlStatus()).move_active, 10,
+                       "the move in the status")
+            assert rospy.ServiceProxy(f"{ns}/contact_control_node/stop", Trigger)().success
+            stopped = rospy.Time.now()
+            wait_until(lambda: (status.last() or ContactControlStatus()).header.stamp > stopped, 10,
+                       "a status after the stop")
+            after = [m for m in list(status.msgs) if m.header.stamp > stopped]
+            assert not any(m.move_active for m in after), "a status after ~stop said the move still ran"
+        finally:
+            status.close()
+            pub.unregister()
+
+
 def test_queued_publishing_mode_still_answers_each_push_with_a_follower_twist(ros_node):
     """publish_synchronously: false (rospy's sender thread) must behave as the default does."""
     import rospy

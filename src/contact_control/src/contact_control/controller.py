@@ -263,6 +263,10 @@ class ContactControl:
     def move_id(self) -> int:
         return self._move_id
 
+    def reacting(self) -> list[bool]:
+        """Per axis, carrying out its exceeded action now (`last_result.reacting` is the last cycle's)."""
+        return self._reaction.reacting()
+
     @property
     def end_ok(self) -> bool:
         """Whether the last move ended by an axis end condition (force limit, max travel, force jump)."""

@@ -376,9 +376,12 @@ class ContactControlRos:
             stamp = rospy.Time.now()
             r, message = self._stage.status()
             guiding = self._stage.guiding
+            # The move's state now, not the last cycle's: after ~stop (or a new law) the next cycle waits for
+            # the next wrench, and a status in between said the stopped move still ran (teach refused a
+            # replay just after hand-guiding was switched off: "a contact move is running").
+            active, reacting = self._stage.ctrl.move_active, any(self._stage.ctrl.reacting())
         msg = self._status_msg  # reused: the status timer allocates nothing per cycle
         msg.header.stamp = stamp
-        msg.move_active = r.move_active
         msg.guiding = guiding
         msg.safety = r.safety
         msg.message = message
@@ -397,6 +400,7 @@ class ContactControlRos:
         if drift is not None:
             msg.zero_drift = list(drift)
         fill_status_words(msg, r)
+        msg.move_active, msg.reacting = active, reacting
         self._status_pub.publish(msg)
 
 
