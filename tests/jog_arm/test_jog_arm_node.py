@@ -260,7 +260,7 @@ def test_invalid_configuration_refuses_to_start(ros_node) -> None:
 
 
 @contextlib.contextmanager
-def ur5_server(rospy, name: str, prefix: str, params: dict, out_class: type, robot: Robot = UR5):
+def arm_server(rospy, name: str, prefix: str, params: dict, out_class: type, robot: Robot = UR5):
     """jog_arm_server for `robot` at its start pose on `prefix` topics: yields (commands, twist sender)."""
     from sensor_msgs.msg import JointState
 
@@ -292,7 +292,7 @@ def test_simu_mode_sends_several_points(ros_node) -> None:
     from trajectory_msgs.msg import JointTrajectory
 
     params = {"simu": True, "simu_points": 3, "pub_period": 0.005}
-    with ur5_server(ros_node, "jog_test_simu", "/jog_simu", params, JointTrajectory) as (commands, sender):
+    with arm_server(ros_node, "jog_test_simu", "/jog_simu", params, JointTrajectory) as (commands, sender):
         sender.start(twist_msg((0.0, 0.0, 0.05, 0.0, 0.0, 0.0)))
         msg = commands.wait_for(10, timeout=10)[-1]
         times = [p.time_from_start.to_sec() for p in msg.points]
@@ -317,7 +317,7 @@ def test_publish_on_command_answers_every_twist_without_waiting_for_the_timer(ro
         "command_out_type": "velocity_array",
         "integrate_from": "measured",
     }
-    with ur5_server(ros_node, "jog_test_on_command", "/jog_oncmd", params, Float64MultiArray) as (
+    with arm_server(ros_node, "jog_test_on_command", "/jog_oncmd", params, Float64MultiArray) as (
         commands,
         sender,
     ):
@@ -356,7 +356,7 @@ def test_contact_controls_twists_pass_the_guard_and_others_do_not(ros_node) -> N
         return float(eef_velocity(model, UR5.start, commands.last().data)[2])
 
     try:
-        with ur5_server(rospy, "jog_test_guard", "/jog_guard", params, Float64MultiArray) as (
+        with arm_server(rospy, "jog_test_guard", "/jog_guard", params, Float64MultiArray) as (
             commands,
             sender,
         ):
@@ -388,7 +388,7 @@ def test_a_five_joint_arm_jogs_and_its_status_names_the_rotation_it_cannot_make(
               "command_out_type": "velocity_array", **SO100.params}
     status = Collector("/jog_so100/status", JogStatus)
     try:
-        with ur5_server(ros_node, "jog_so100", "/jog_five", params, Float64MultiArray, SO100) as (commands,
+        with arm_server(ros_node, "jog_so100", "/jog_five", params, Float64MultiArray, SO100) as (commands,
                                                                                                 sender):
             sender.start(twist_msg((0.02, 0.0, 0.0, 0.0, 0.0, 0.0)))
             commands.wait_for(20, timeout=10)

@@ -128,13 +128,14 @@ class DampedSolver:
             ratio = s_min / self._damping_threshold
             damping2 = self._damping2 * (1.0 - ratio * ratio) + _DAMPING_FLOOR
             A += self._eye6 * damping2
-        if task is not None:
+        if task is not None:  # its own factorisation; the Cholesky one below is J⁺'s
             task.update(J, damping2)
-        llt = self._llt
-        llt.compute(A)
-        if llt.info() != eigenpy.ComputationInfo.Success:  # numerically singular: damp harder
-            A += self._eye6 * (_DAMPING_FLOOR + 1e-6 * s2_max)
+        else:
+            llt = self._llt
             llt.compute(A)
+            if llt.info() != eigenpy.ComputationInfo.Success:  # numerically singular: damp harder
+                A += self._eye6 * (_DAMPING_FLOOR + 1e-6 * s2_max)
+                llt.compute(A)
         g.q = list(q_ref)
         g.q_arr, g.J = q_arr, J
         g.condition = math.sqrt(s2_max / s2_min) if s2_min > 0.0 else math.inf
@@ -145,9 +146,9 @@ class DampedSolver:
         """dq = J⁺x with the J⁺ of the last :meth:`geometry` (whose `J` this is); on a redundant arm plus
         the null-space pull toward the posture, scaled by `scale`:
         J⁺x + (I - J⁺J)·pull = J⁺(x - J·pull) + pull."""
-        llt = self._llt
         if self.task is not None:
             return self.task.solve(x)
+        llt = self._llt
         if not self._redundant:
             solved: FloatArray = llt.solve(x)  # eigenpy: untyped
             return J.T @ solved
