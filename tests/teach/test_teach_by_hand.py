@@ -56,8 +56,11 @@ def test_a_hand_guided_l_is_recorded_and_replayed_within_2_mm(ros_node, tmp_path
 
             client = actionlib.SimpleActionClient("/teach/replay", ReplayProgramAction)
             assert client.wait_for_server(rospy.Duration(20.0))
-            # Twice this fast hand (0.24 m/s, four times its accelerations) is beyond the arm's limits: the
-            # replay's timing is planned within them (slower where it must be), and says so.
+            # This hand is at the arm's limits (0.12 m/s; its 1 x replay is slowed about 10 %). Twice as fast is
+            # beyond them: the replay's timing is planned within them (slower where it must be), and says so.
+            # The premise is checked by the 1 x replay: once in CI the recording took 60 s for this 2 s L (the
+            # simulation starved) and its 1 x replay needed no slowing, so 2 x may fit within the limits.
+            at_limits = False
             for speed in (1.0, 2.0):
                 client.send_goal(ReplayProgramGoal(name="l_by_hand", speed=speed))
                 assert client.wait_for_result(rospy.Duration(90.0))
@@ -69,7 +72,8 @@ def test_a_hand_guided_l_is_recorded_and_replayed_within_2_mm(ros_node, tmp_path
                 # coast stopped faster than the arm is planned to (about 10 %).
                 planned = re.search(r"\(([\d.]+) s planned instead of ([\d.]+) s\)", result.message)
                 if speed > 1.0:
-                    assert planned is not None, result.message
+                    assert planned is not None or not at_limits, result.message
                 elif planned is not None:
+                    at_limits = True
                     assert float(planned[1]) <= 1.25 * float(planned[2]), result.message
         h.stop()
