@@ -259,10 +259,12 @@ def test_a_request_re_sent_at_100_hz_during_a_push_does_not_change_the_motion(ro
                     thread.join()
                 return _tip(pose)[2] - z0, sent[0]
 
-            # A VM stall during one push (the spamming thread adds load) lets the arm run on for its length
-            # (35.0 vs 40.1 mm once in CI; 0.2 mm for the quiet push once with two suites on the machine): a
-            # pair of pushes is repeated, at most 3 times, all printed. A restart from rest on every request
-            # would fail every pair (0.7 vs 21 mm before the fix).
+            # A restart from rest on every request cut the travel 30-fold (0.7 vs 21 mm before the fix); a
+            # third off is well outside what load does to a correct stack. Load does change both pushes: a VM
+            # stall lets the arm run on (35.0 vs 40.1 mm once in CI), a starved stack moved 0.2 mm for the
+            # quiet push once, and a starved client re-sent only 4-41 times in a push (about 40 when quiet;
+            # 10 restarts would leave about 12 % of the travel, from the first-order ramp that 0.7 of 21 mm at
+            # 100 Hz implies). So a pair is repeated, at most 3 times, all printed.
             for _ in range(3):
                 quiet, _ = pushed(5.0, spam=False)
                 pushed(-5.0, spam=False)  # back down
@@ -270,11 +272,11 @@ def test_a_request_re_sent_at_100_hz_during_a_push_does_not_change_the_motion(ro
                 pushed(-5.0, spam=False)
                 print(f"\nfollower under a 5 N push: {quiet * 1e3:.1f} mm; with the request re-sent {sent} "
                       f"times meanwhile: {spammed * 1e3:.1f} mm")
-                if quiet > 0.01 and sent >= 20 and spammed == pytest.approx(quiet, rel=0.10):
+                if quiet > 0.01 and sent >= 10 and spammed == pytest.approx(quiet, rel=0.30):
                     break
             assert quiet > 0.01, h.output()[-3000:]
-            assert sent >= 20
-            assert spammed == pytest.approx(quiet, rel=0.10)
+            assert sent >= 10
+            assert spammed == pytest.approx(quiet, rel=0.30)
         finally:
             configure.close()
             pose.close()
