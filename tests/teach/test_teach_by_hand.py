@@ -56,10 +56,10 @@ def test_a_hand_guided_l_is_recorded_and_replayed_within_2_mm(ros_node, tmp_path
 
             client = actionlib.SimpleActionClient("/teach/replay", ReplayProgramAction)
             assert client.wait_for_server(rospy.Duration(20.0))
-            # This hand is at the arm's limits (0.12 m/s; its 1 x replay is slowed about 10 %). Twice as fast is
-            # beyond them: the replay's timing is planned within them (slower where it must be), and says so.
-            # The premise is checked by the 1 x replay: once in CI the recording took 60 s for this 2 s L (the
-            # simulation starved) and its 1 x replay needed no slowing, so 2 x may fit within the limits.
+            # This hand is at the arm's limits (0.12 m/s; its 1 x replay is slowed about 10 %). Twice as fast
+            # is beyond them: the replay's timing is planned within them (slower where it must be), and says
+            # so. The premise is checked by the 1 x replay: once in CI the recording took 60 s for this 2 s L
+            # (the simulation starved, probably) and its 1 x replay needed no slowing: 2 x may then fit.
             at_limits = False
             for speed in (1.0, 2.0):
                 client.send_goal(ReplayProgramGoal(name="l_by_hand", speed=speed))
