@@ -59,6 +59,10 @@ MIN_MARGIN = 0.15
 MIN_JOINT_HEIGHT = 0.05
 
 
+# StartPoseError says this when no posture points the tool down where the demos start (smaller demos: neither)
+NO_TOOL_DOWN = "no tool-down IK solution in front of the robot"
+
+
 class StartPoseError(StackError, RuntimeError):
     """No start pose satisfies the demands (the message says which were tried and why they failed)."""
 
@@ -443,8 +447,7 @@ def find_start_pose(
             score = report.worst_condition + 2.0 * _off_centre(arm, q) - 0.5 * min(report.min_margin, 1.0)
             if closest is None or score < closest[0]:
                 closest = (score, report)
-        none = "no tool-down IK solution in front of the robot"
-        detail = "; ".join(closest[1].problems()) if closest else none
+        detail = "; ".join(closest[1].problems()) if closest else NO_TOOL_DOWN
         raise StartPoseError(
             "no start pose with the tool pointing down lets the demos' motions run (reach estimate "
             f"{reach:.2f} m, "

@@ -33,30 +33,33 @@ from compliant_common.errors import StackError
 from control_stack.description import (
     ERD_PACKAGE,
     DescriptionError,
-    ToolSpec,
     build_description,
     find_example_robot_data,
     read_source,
 )
-from jog_arm.kinematics import ArmModel, KinematicsError
+from jog_arm.kinematics import ArmModel
 from thesis_demos.geometry import SURFACE_TRAVEL, DemoGeometry, demo_motions
+from thesis_demos.scenarios import HYBRID_PUSH_DURATION, HYBRID_PUSH_START
 
 from robot_setup import templates
 from robot_setup.analysis import (
     LENGTH_SCALE,
-    PoseReport,
-    StartPoseError,
     analyse_pose,
     estimate_reach,
-    find_start_pose,
     lowest_joint,
-    sample_range,
     tip_path,
-    tool_down_heights,
 )
-from robot_setup.collisions import CollisionChecker
 from robot_setup.driver import DriverError, driver_interface
-from robot_setup.plan import Plan, RobotSpec, command_line, parse_held, parse_rpy, recorded_command
+from robot_setup.mounting import TOOL_SIZE, Mounter, Mounting, NoMountingError
+from robot_setup.plan import (
+    GeneratorError,
+    Plan,
+    RobotSpec,
+    command_line,
+    parse_held,
+    parse_rpy,
+    recorded_command,
+)
 from robot_setup.sensor_limits import contact_force_for
 
 # Plan, RobotSpec, command_line and recorded_command live in robot_setup.plan (the templates read them too);
@@ -68,20 +71,18 @@ __all__ = ["GeneratorError", "Plan", "RobotSpec", "command_line", "main", "plan_
 # (0.30 m hybrid travel, obstacle 7 cm below the tip); shorter arms get them scaled by reach / this. The
 # thesis's two arms, with the 0.12 m tool, reach 0.96 and 1.01 m measured this way (tests/robot_setup).
 REFERENCE_REACH = 0.9
-# A straight mounting whose demos reach a worse condition number than this has the adapters tried too (the
-# UR3's ee_link, whose z is across the flange: 21.6, its touching on the block overshot to 26 N and tripped
-# the 25 N global limit; the UR3 on tool0 13.2, the Jaco2 5.4, left as they were).
-POOR_CONDITION = 15.0
-TOOL_SIZE = (0.03, 0.12)  # [m] cylinder radius, length: the hand-written packages' tool
-TOOL_COM = (0.0, 0.0, 0.05)  # [m] in the sensor frame
+# When no mounting has a start pose for the demos at that scale, they are tried smaller, by this factor each
+# time, down to MIN_SCALE (0.06 m hybrid travel): a small arm's tool-down workspace is smaller than its reach
+# says (the SO-100: reach 0.45 m with the 0.12 m tool, start poses only with the demos at 0.28).
+SCALE_STEP, MIN_SCALE = 0.75, 0.2
+# The hybrid's compliant move on X runs at the thesis's 0.05 m/s unless it would end less than this after its
+# push on Z: the Z spring (b/k = 0.3 s) needs ~3 time constants to come back within 2 mm, rounded up. At scale
+# 0.38 (the SO-100) the 0.11 m move had ended during the push, Z still 5 mm up; the UR3's 0.22 m is unchanged.
+HYBRID_AFTER_PUSH = 0.8  # [s]
 # Servo gain per newton-metre of the URDF's joint effort, capped (stiff like an industrial controller).
 KP_PER_NM, KP_MAX, KP_MIN = 120.0, 20000.0, 1000.0
 KV_RATIO = 0.02  # kv = kp * this [s]
-MIN_JOINTS = 6  # jog_arm jogs 3 to 5 (translation first); the start pose search and demos need 6 so far
-
-
-class GeneratorError(StackError):
-    """Bad input (unknown link, missing URDF, bad name or mass), named."""
+MIN_JOINTS = 5  # jog_arm jogs 3 to 5 (translation first); the start pose search and demos need 6 so far
 
 
 def _source(urdf: str) -> tuple[str, str]:
@@ -191,118 +192,23 @@ def _held_positions(
     return tuple(held)
 
 
-# Adapter angles tried when the straight mounting cannot point the tool down (roll, pitch, yaw of the sensor
-# on the flange) [rad]: right-angle and 45-degree brackets about the flange's x and y axes.
-ADAPTERS = tuple(
-    (r * math.pi / 4.0, p * math.pi / 4.0, 0.0) for r, p in
-    ((2, 0), (-2, 0), (0, 2), (0, -2), (1, 0), (-1, 0), (0, 1), (0, -1))
-)
-
-
-def _mid(arm: ArmModel) -> np.ndarray:
-    """The middle of each bounded joint's range, 0 for an unbounded one (a posture inside every limit)."""
-    bounded = np.isfinite(arm.lower) & np.isfinite(arm.upper)
-    return (np.where(bounded, arm.lower, 0.0) + np.where(bounded, arm.upper, 0.0)) / 2.0
-
-
-def _tool(spec: RobotSpec, rpy: Sequence[float]) -> ToolSpec:
-    return ToolSpec(parent=spec.tip, mass=spec.tool_mass, com=TOOL_COM, size=TOOL_SIZE,
-                    ft_rpy=(float(rpy[0]), float(rpy[1]), float(rpy[2])))
-
-
-def _arm(urdf_xml: str, chain: Sequence[str], held: Sequence[tuple[str, float]], name: str) -> ArmModel:
-    try:
-        return ArmModel(urdf_xml, ToolSpec.tip_name, chain, held_positions=dict(held))
-    except KinematicsError as exc:
-        raise GeneratorError(f"jog_arm cannot model the {name}: {exc}") from exc
-
-
-def _tool_stuck(arm: ArmModel, contacts: Callable[[Sequence[float] | np.ndarray], list[str]]) -> str:
-    """What the tool touches in every one of 8 fixed pseudo-random postures ("" if nothing): a mounting that
-    puts it inside the wrist, which no start pose search can mend (found in milliseconds, not seconds)."""
-    rng = np.random.default_rng(4)
-    lo, hi = sample_range(arm)
-    always: set[str] | None = None
-    for _ in range(8):
-        touching = {pair for pair in contacts(lo + (hi - lo) * rng.random(arm.nv))
-                    if ToolSpec.name in pair.split(" / ")}
-        always = touching if always is None else always & touching
-        if not always:
-            return ""
-    return ", ".join(sorted(always or ()))
-
-
-def _start_pose(
-    arm: ArmModel, reach: float, motions: dict, heights: list[float],
-    contacts: Callable[[Sequence[float] | np.ndarray], list[str]],
-) -> PoseReport:
-    """find_start_pose, after the quick check that the tool is not stuck in the arm.
-
-    Raises:
-        StartPoseError: Why there is none.
-    """
-    stuck = _tool_stuck(arm, contacts)
-    if stuck:
-        raise StartPoseError(f"the tool, mounted this way, touches the arm in every posture ({stuck})")
-    return find_start_pose(arm, reach, lambda tip: motions, heights=heights, contacts=contacts)
-
-
-def _adapter(
-    stock: str, spec: RobotSpec, removed: tuple[str, ...], chain: Sequence[str],
-    held: Sequence[tuple[str, float]], reach: float, motions: dict, gap: float, straight: str,
-    log: Callable[[str], object],
-) -> tuple[
-    tuple[float, float, float], str, ArmModel, Callable[[Sequence[float] | np.ndarray], list[str]], PoseReport
-]:
-    """The adapter angle (of ADAPTERS) whose start pose keeps the widest joint-limit margin on the demos'
-    motions (ties: the lower worst condition number), with its description, model, collision check and pose.
-
-    Raises:
-        GeneratorError: No angle works either (the straight mounting's reason, and the angles tried).
-    """
-    best = None
-    for rpy in ADAPTERS:
-        urdf_xml = build_description(stock, _tool(spec, rpy), removed)
-        arm = _arm(urdf_xml, chain, held, spec.name)
-        mid = _mid(arm)
-        contacts = CollisionChecker(urdf_xml, arm.joint_names, mid, dict(held)).contacts
-        words = f"roll {math.degrees(rpy[0]):g} pitch {math.degrees(rpy[1]):g} deg"
-        try:
-            found = _start_pose(arm, reach, motions, _heights(arm, reach, gap), contacts)
-        except StartPoseError as exc:
-            stuck = str(exc) if "touches the arm" in str(exc) else ""
-            log(f"[robot]   adapter {words}: no start pose{f' ({stuck})' if stuck else ''}")
-            continue
-        log(f"[robot]   adapter {words}: margin {found.min_margin:.2f} rad, condition <= "
-            f"{found.worst_condition:.2f}")
-        key = (-round(found.min_margin, 3), found.worst_condition)
-        if best is None or key < best[0]:
-            best = (key, (rpy, urdf_xml, arm, contacts, found))
-    if best is None:
-        raise GeneratorError(f"{straight}; nor with the sensor on an adapter at 45 or 90 degrees about the "
-                             "flange's x or y axis: give the mounting with TOOL_RPY=roll,pitch,yaw")
-    return best[1]
-
-
-def _chosen(rpy: Sequence[float]) -> str:
-    return (f"[robot] adapter chosen: TOOL_RPY={','.join(f'{v:.10g}' for v in rpy)} (roll "
-            f"{math.degrees(rpy[0]):g}, pitch {math.degrees(rpy[1]):g} deg), into config/description.args")
-
-
-def _heights(arm: ArmModel, reach: float, gap: float) -> list[float]:
-    """The start pose search's tool-tip heights: over the table (the URDF root's z = 0 plane) by a fraction of
-    the reach; for an arm whose first joint stands higher than half its reach over the table (on a torso),
-    where its tool can point down."""
-    mid = _mid(arm)
-    first = arm.joint_names[0]
-    shoulder = float(arm.frame_pose(mid, first).translation[2]) if arm.has_frame(first) else 0.0
-    fractions = [reach * f for f in (0.2, 0.28, 0.36, 0.45)]
-    return [h for h in (fractions if shoulder < 0.5 * reach else tool_down_heights(arm, reach))
-            if h >= gap + 0.04]
-
-
 def _round(value: float, step: float) -> float:
     return round(round(value / step) * step, 6)
+
+
+def _demos(scale: float) -> tuple[float, DemoGeometry]:
+    """(obstacle gap [m], the demonstrations' numbers) at `scale` of the thesis's."""
+    gap = _round(max(0.04, 0.07 * scale), 0.005)
+    travel = _round(0.30 * scale, 0.01)
+    least = HYBRID_PUSH_START + HYBRID_PUSH_DURATION + HYBRID_AFTER_PUSH  # [s] the hybrid move lasts this
+    return gap, DemoGeometry(
+        # The follower rises about F/b x 0.8 s (0.13 m at 5 N): less push, less rise on a small arm; above the
+        # 2.5 N follower deadband and long enough to reach F/b at contact_control's acceleration.
+        follower_push_force=_round(max(3.5, 5.0 * scale), 0.1),
+        compliant_max_travel=_round(gap + 0.08, 0.01),
+        hybrid_travel=travel,
+        hybrid_speed=min(0.05, math.floor(travel / least * 1000.0) / 1000.0),
+    )
 
 
 def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
@@ -331,7 +237,8 @@ def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
     chain = _chain(children, base, spec.tip)
     removed = tuple(child for child, _, _ in children.get(spec.tip, []))
     rpy = spec.tool_rpy if spec.tool_rpy is not None else (0.0, 0.0, 0.0)
-    urdf_xml = build_description(stock, _tool(spec, rpy), removed)
+    mounter = Mounter(stock, spec, removed, chain, ())
+    urdf_xml = build_description(stock, mounter.tool(rpy), removed)
     held = _held_positions(urdf_xml, chain, dict(spec.held), spec)
     missing = driver.missing_links({lnk.get("name", "") for lnk in ET.fromstring(urdf_xml).findall("link")})
     if missing:
@@ -339,12 +246,13 @@ def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
             f"DRIVER={spec.driver}: the profile's frames are not in the {name} description (the emulated "
             f"driver would refuse it): {'; '.join(missing)}"
         )
-    arm = _arm(urdf_xml, chain, held, name)
+    mounter = Mounter(stock, spec, removed, chain, held)
+    urdf_xml, arm, _ = mounter.build(rpy)
     if arm.nv < MIN_JOINTS:
         raise GeneratorError(
             f"{arm.nv} joints between {base} and {spec.tip} ({', '.join(arm.joint_names)}): jog_arm jogs "
-            f"arms with fewer than 6 (translation first), but make robot's start pose search and "
-            f"demonstrations need {MIN_JOINTS} or more so far (robot_setup README)"
+            f"arms with 3 or more (translation first), but pointing the tool down over a point takes "
+            f"{MIN_JOINTS}, and make robot's start pose and demonstrations need that (robot_setup README)"
         )
     reach = estimate_reach(arm)
     log(f"[robot] {spec.name}: {arm.nv} joints {list(arm.joint_names)}, tool-tip reach ~{reach:.2f} m")
@@ -353,56 +261,32 @@ def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
             + ", ".join(f"{j} = {v:g}" for j, v in held))
     log(f"[robot] {driver.summary()}")
     scale = min(1.0, reach / REFERENCE_REACH)
-    gap = _round(max(0.04, 0.07 * scale), 0.005)
-    geometry = DemoGeometry(
-        # The follower rises about F/b x 0.8 s (0.13 m at 5 N): less push, less rise on a small arm; above the
-        # 2.5 N follower deadband and long enough to reach F/b at contact_control's acceleration.
-        follower_push_force=_round(max(3.5, 5.0 * scale), 0.1),
-        compliant_max_travel=_round(gap + 0.08, 0.01),
-        hybrid_travel=_round(0.30 * scale, 0.01),
-    )
-    log(
-        f"[robot] demos scaled by {scale:.2f}: hybrid travel {geometry.hybrid_travel:.2f} m along "
-        f"{'-' if geometry.hybrid_direction < 0 else '+'}X, obstacle {gap * 100:.1f} cm below the tip, "
-        f"compliant move at most {geometry.compliant_max_travel:.2f} m"
-    )
+    while True:
+        gap, geometry = _demos(scale)
+        log(
+            f"[robot] demos scaled by {scale:.2f}: hybrid travel {geometry.hybrid_travel:.2f} m along "
+            f"{'-' if geometry.hybrid_direction < 0 else '+'}X, obstacle {gap * 100:.1f} cm below the tip, "
+            f"compliant move at most {geometry.compliant_max_travel:.2f} m"
+        )
+        motions = demo_motions(geometry, approach=gap)
+        try:
+            mounting: Mounting = mounter.search(reach, motions, gap, log)
+            break
+        except NoMountingError as exc:
+            smaller = scale * SCALE_STEP
+            if exc.hopeless or smaller < MIN_SCALE:
+                if scale < min(1.0, reach / REFERENCE_REACH):
+                    raise GeneratorError(f"{exc} (demos scaled down to {scale:.2f})") from exc
+                raise
+            log(f"[robot] no start pose for the demos at this scale: trying them smaller (a tool-down "
+                f"workspace smaller than the reach: {exc})")
+            scale = smaller
     if spec.driver:  # written into demos.yaml by the templates
         force = contact_force_for(spec.driver, geometry.contact_force_limit)
         log(f"[robot] demos' contact force with {spec.driver}: {force.limit:g} N ({force.comment()})")
-    motions = demo_motions(geometry, approach=gap)
-    mid = _mid(arm)
-    heights = _heights(arm, reach, gap)
-    contacts: Callable[[Sequence[float] | np.ndarray], list[str]]
-    contacts = CollisionChecker(urdf_xml, arm.joint_names, mid, dict(held)).contacts
-    adapter = ""
-    try:
-        found = _start_pose(arm, reach, motions, heights, contacts)
-    except StartPoseError as exc:
-        if spec.tool_rpy is not None:  # the user's mounting: say why it does not work
-            raise GeneratorError(f"TOOL_RPY={','.join(f'{v:g}' for v in rpy)}: {exc}") from exc
-        log("[robot] the straight mounting cannot point the tool down for the demos; trying adapter angles")
-        mounted = _adapter(stock, spec, removed, chain, held, reach, motions, gap,
-                           f"straight on {spec.tip}: {exc}", log)
-        rpy, urdf_xml, arm, contacts, found = mounted
-        log(_chosen(rpy))
-        adapter = (f"an adapter make robot chose: the straight mounting had no tool-down start pose, this "
-                   f"angle keeps the most margin ({found.min_margin:.2f} rad)")
-    else:
-        if spec.tool_rpy is None and found.worst_condition > POOR_CONDITION:
-            straight = found.worst_condition
-            log(f"[robot] the straight mounting's demos reach condition number {straight:.2f} (over "
-                f"{POOR_CONDITION:g}); trying adapter angles")
-            try:
-                better = _adapter(stock, spec, removed, chain, held, reach, motions, gap, "", log)
-            except GeneratorError:
-                better = None
-            if better is not None and better[4].worst_condition < straight:
-                rpy, urdf_xml, arm, contacts, found = better
-                log(_chosen(rpy))
-                adapter = (f"an adapter make robot chose: the straight mounting's demos reached condition "
-                           f"number {straight:.2f}, this angle's {found.worst_condition:.2f}")
-            else:
-                log("[robot] straight kept: no adapter angle does better")
+    rpy, urdf_xml, arm, contacts, found = (mounting.rpy, mounting.urdf_xml, mounting.arm, mounting.contacts,
+                                           mounting.found)
+    adapter = mounting.adapter
     q0 = np.round(found.q, 4)  # what the files say, analysed again as written
     start = analyse_pose(arm, q0, motions, contacts=contacts)
     tip = start.tip

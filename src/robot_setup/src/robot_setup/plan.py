@@ -10,12 +10,19 @@ import re
 from dataclasses import dataclass
 
 import numpy as np
+from compliant_common.errors import StackError
 from thesis_demos.geometry import DemoGeometry
 
 from robot_setup.analysis import PoseReport
 from robot_setup.driver import DriverInterface
 
-__all__ = ["Plan", "RobotSpec", "command_line", "parse_held", "parse_rpy", "recorded_command"]
+__all__ = [
+    "GeneratorError", "Plan", "RobotSpec", "command_line", "parse_held", "parse_rpy", "recorded_command",
+]
+
+
+class GeneratorError(StackError):
+    """Bad input (unknown link, missing URDF, bad name or mass), or no usable start pose; named."""
 
 
 @dataclass(frozen=True)

@@ -104,6 +104,11 @@ class Scenario:
         return self.uses_laws_service or self.press_force > 0.0
 
 
+# The hybrid's push up on Z [s]: from 1.5 s, for 2 s (the compliant move on X must still run when it ends and
+# the spring has brought Z back: robot_setup slows a short move so that it does).
+HYBRID_PUSH_START, HYBRID_PUSH_DURATION = 1.5, 2.0
+
+
 # Thesis section 6.4, with the numbers it gives. Where it is silent: pushes of 5 N (follower) and
 # 15 N (spring), V_desired -0.01 m/s (down, onto the obstacle: a usual approach speed for contact,
 # and the contact force grows with it) and -0.05 m/s along X. Directions and distances depend on the arm and
@@ -170,7 +175,7 @@ def build_scenarios(geometry: DemoGeometry | None = None) -> tuple[Scenario, ...
                 ),
                 "z": AxisLaw(SPRING, damping=30.0, stiffness=100.0),
             },
-            pushes=(Push(1.5, 2.0, (0.0, 0.0, 15.0)),),
+            pushes=(Push(HYBRID_PUSH_START, HYBRID_PUSH_DURATION, (0.0, 0.0, 15.0)),),
             duration=max(9.0, 3.0 + 1.5 * g.hybrid_travel / g.hybrid_speed),
             end_when_move_ends=True,
             controlled=("x", "z"),

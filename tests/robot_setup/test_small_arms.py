@@ -1,0 +1,63 @@
+"""make robot on small and 5-joint arms (#24 part 3): the demonstrations shrink to the arm's tool-down
+workspace when its reach promises more than that workspace holds, the hybrid's move outlasts its push, and an
+arm no mounting can point down is refused in one line without the search being repeated per demo size."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from control_stack.description import ToolSpec
+from jog_arm.kinematics import ArmModel
+from robot_setup.analysis import MIN_MARGIN, NO_TOOL_DOWN
+from robot_setup.generate import GeneratorError, RobotSpec, plan_robot
+from thesis_demos.scenarios import HYBRID_PUSH_DURATION, HYBRID_PUSH_START
+
+from robot_setup import generate
+
+SO100 = RobotSpec("so100", "so_arm_description/urdf/so100.urdf", "gripper")
+HEXTILT = RobotSpec("hextilt", "hextilt_description/urdf/hextilt_flying_arm_5.urdf", "flying_arm_5__gripper")
+LEAST_HYBRID = HYBRID_PUSH_START + HYBRID_PUSH_DURATION + generate.HYBRID_AFTER_PUSH  # [s]
+
+
+@pytest.fixture(scope="module")
+def so100():
+    lines: list[str] = []
+    return plan_robot(SO100, log=lines.append), lines
+
+
+def test_a_small_five_joint_arm_gets_its_demos_scaled_to_where_its_tool_points_down(so100):
+    """The SO-100 reaches 0.45 m with the 0.12 m tool (demos at 0.50), but its tool points down over the table
+    only near its base: at 0.50 no mounting has a start pose, at 0.38 one does."""
+    plan, lines = so100
+    assert len(plan.joints) == 5
+    tried = [line for line in lines if line.startswith("[robot] demos scaled by")]
+    assert tried[0].startswith("[robot] demos scaled by 0.50") and len(tried) == 2, lines
+    assert any("trying them smaller" in line for line in lines), lines
+    assert plan.geometry.hybrid_travel == pytest.approx(0.11)  # 0.30 x 0.38 (0.15 at the reach's 0.50)
+    arm = ArmModel(plan.urdf_xml, ToolSpec.tip_name, plan.joints, held_positions=dict(plan.held))
+    assert arm.frame_pose(plan.start.q, arm.tip_frame).rotation[2, 2] < -0.999  # the tool points down
+    assert plan.start.reachable and plan.start.collision_free and plan.start.min_margin >= MIN_MARGIN
+    assert plan.tip_in_base[2] > plan.gap + 0.04  # over the block, the block over the table
+
+
+def test_the_hybrid_move_still_runs_when_its_push_has_ended_and_the_spring_is_back(so100):
+    plan, _ = so100
+    g = plan.geometry
+    # At 0.05 m/s the SO-100's 0.11 m move ended 1.3 s into the 2 s push, Z still 5 mm up (demo, by hand).
+    assert g.hybrid_travel / g.hybrid_speed >= LEAST_HYBRID - 1e-9
+    for scale in np.linspace(generate.MIN_SCALE, 1.0, 41):
+        _, g = generate._demos(float(scale))
+        assert g.hybrid_travel / g.hybrid_speed >= LEAST_HYBRID - 1e-9, scale
+        if g.hybrid_travel >= 0.05 * LEAST_HYBRID:  # long enough: the thesis's speed, as before
+            assert g.hybrid_speed == 0.05, scale
+
+
+def test_an_arm_no_mounting_can_point_down_is_refused_in_one_line_after_one_search():
+    """A flying arm's 5 joints cannot point its tool down in front of it on any mounting: smaller demos would
+    not change that, so they are not tried (each costs a search of 9 mountings)."""
+    lines: list[str] = []
+    with pytest.raises(GeneratorError) as err:
+        plan_robot(HEXTILT, log=lines.append)
+    message = str(err.value)
+    assert NO_TOOL_DOWN in message and "TOOL_RPY=" in message and "\n" not in message
+    assert sum(line.startswith("[robot] demos scaled by") for line in lines) == 1, lines
