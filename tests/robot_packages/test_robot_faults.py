@@ -223,16 +223,15 @@ def test_a_request_re_sent_at_100_hz_during_a_push_does_not_change_the_motion(ro
             "/configure_cartesian_impedance", ConfigureForceControl, persistent=True
         )
         push_srv = rospy.ServiceProxy("/mujoco_driver/push", PushEEF)
+        status = Collector("/contact_control_node/status", ContactControlStatus)
         try:
             pose.wait_for(1, 20)
             joints.wait_for(1, 20)
             # contact_control is processing wrenches (tared, data fresh) before the laws are set: pushing
             # within ~50 ms of start-up, before its first wrench, sometimes latched it at 237-262 N (see
             # contact_control's README, Open items)
-            status = Collector("/contact_control_node/status", ContactControlStatus)
             wait_until(lambda: status.last() is not None and status.last().safety == 0, 20,
                        "contact_control to process wrenches")
-            status.close()
             assert configure(req).success
 
             def pushed(fz: float, spam: bool) -> tuple[float, int]:
@@ -243,7 +242,10 @@ def test_a_request_re_sent_at_100_hz_during_a_push_does_not_change_the_motion(ro
 
                 def resend() -> None:
                     while not stop.wait(0.01):
-                        assert configure(req).success
+                        answer = configure(req)
+                        if not answer.success:  # said in the pair's line, not lost in a thread
+                            refused.append(answer.message)
+                            return
                         sent[0] += 1
 
                 thread = threading.Thread(target=resend, daemon=True)
@@ -265,19 +267,31 @@ def test_a_request_re_sent_at_100_hz_during_a_push_does_not_change_the_motion(ro
             # quiet push once, and a starved client re-sent only 4-41 times in a push (about 40 when quiet;
             # 10 restarts would leave about 12 % of the travel, from the first-order ramp that 0.7 of 21 mm at
             # 100 Hz implies). So a pair is repeated, at most 3 times, all printed.
+            # A starved machine can also stall the wrenches long enough to end the follower (no wrench data)
+            # or get a re-sent request refused: the stack doing its job, which spoils the pair for this
+            # comparison. Such a pair is named (contact_control's status) and repeated; any other is judged.
             for _ in range(3):
+                refused: list[str] = []
+                status.clear()
                 quiet, _ = pushed(5.0, spam=False)
                 pushed(-5.0, spam=False)  # back down
                 spammed, sent = pushed(5.0, spam=True)
                 pushed(-5.0, spam=False)
+                faults = {(m.safety_name, m.message) for _, m in status.timed()
+                          if m.safety or not m.move_active}
                 print(f"\nfollower under a 5 N push: {quiet * 1e3:.1f} mm; with the request re-sent {sent} "
-                      f"times meanwhile: {spammed * 1e3:.1f} mm")
+                      f"times meanwhile: {spammed * 1e3:.1f} mm; refused {refused}; contact_control {faults}")
+                if faults or refused:
+                    assert configure(req).success  # the follower again after the stall ended it
+                    continue
                 if quiet > 0.01 and sent >= 10 and spammed == pytest.approx(quiet, rel=0.30):
                     break
+            assert not faults and not refused, "every pair was spoilt by a stalled stack"
             assert quiet > 0.01, h.output()[-3000:]
             assert sent >= 10
             assert spammed == pytest.approx(quiet, rel=0.30)
         finally:
             configure.close()
+            status.close()
             pose.close()
             joints.close()
