@@ -224,6 +224,7 @@ def test_a_request_re_sent_at_100_hz_during_a_push_does_not_change_the_motion(ro
         )
         push_srv = rospy.ServiceProxy("/mujoco_driver/push", PushEEF)
         status = Collector("/contact_control_node/status", ContactControlStatus)
+        jogging = Collector("/jog_arm_server/status", JogStatus)
         try:
             pose.wait_for(1, 20)
             joints.wait_for(1, 20)
@@ -244,7 +245,7 @@ def test_a_request_re_sent_at_100_hz_during_a_push_does_not_change_the_motion(ro
                     while not stop.wait(0.01):
                         answer = configure(req)
                         if not answer.success:  # said in the pair's line, not lost in a thread
-                            refused.append(answer.message)
+                            refused.append(answer.error)
                             return
                         sent[0] += 1
 
@@ -253,8 +254,13 @@ def test_a_request_re_sent_at_100_hz_during_a_push_does_not_change_the_motion(ro
                     thread.start()
                 push = PushEEFRequest(duration=0.4)
                 push.wrench.force.z = fz
+                pushed_at = pose.last().header.stamp
                 assert push_srv(push).success
-                wait_until(lambda: not _stopped(joints), 5, "the push to move the arm")
+                # Past the push's end (the driver's time) before judging rest: the arm is at rest for a while
+                # after the push begins, until the filtered force passes the deadband (on a loaded machine the
+                # first motion was a push's early twitch, the follower's travel landing in the next push).
+                ended = pushed_at + rospy.Duration(push.duration + 0.1)
+                wait_until(lambda: pose.last().header.stamp >= ended, 10, "the push to end")
                 wait_until(lambda: _stopped(joints), 10, "the arm to stop after the push")
                 stop.set()
                 if spam:
@@ -273,12 +279,18 @@ def test_a_request_re_sent_at_100_hz_during_a_push_does_not_change_the_motion(ro
             for _ in range(3):
                 refused: list[str] = []
                 status.clear()
+                jogging.clear()
                 quiet, _ = pushed(5.0, spam=False)
                 pushed(-5.0, spam=False)  # back down
                 spammed, sent = pushed(5.0, spam=True)
                 pushed(-5.0, spam=False)
                 faults = {(m.safety_name, m.message) for _, m in status.timed()
                           if m.safety or not m.move_active}
+                # jog_arm's halts (stale or missing joint states, paused, a bad command): the stack's job
+                # (STALE_COMMAND is its idle state between pushes).
+                halts = (JogStatus.NO_JOINT_STATE, JogStatus.STALE_JOINT_STATE, JogStatus.PAUSED,
+                         JogStatus.INVALID_COMMAND)
+                faults |= {(m.code_name, m.message) for _, m in jogging.timed() if m.code in halts}
                 print(f"\nfollower under a 5 N push: {quiet * 1e3:.1f} mm; with the request re-sent {sent} "
                       f"times meanwhile: {spammed * 1e3:.1f} mm; refused {refused}; contact_control {faults}")
                 if faults or refused:
@@ -289,9 +301,10 @@ def test_a_request_re_sent_at_100_hz_during_a_push_does_not_change_the_motion(ro
             assert not faults and not refused, "every pair was spoilt by a stalled stack"
             assert quiet > 0.01, h.output()[-3000:]
             assert sent >= 10
-            assert spammed == pytest.approx(quiet, rel=0.30)
+            assert spammed == pytest.approx(quiet, rel=0.30), h.output()[-4000:]
         finally:
             configure.close()
             status.close()
+            jogging.close()
             pose.close()
             joints.close()
