@@ -38,6 +38,7 @@ from control_stack.description import (
     read_source,
 )
 from jog_arm.kinematics import ArmModel
+from jog_arm.settings import JogSettings
 from thesis_demos.geometry import SURFACE_TRAVEL, DemoGeometry, demo_motions
 from thesis_demos.scenarios import HYBRID_PUSH_DURATION, HYBRID_PUSH_START
 
@@ -61,6 +62,7 @@ from robot_setup.plan import (
     recorded_command,
 )
 from robot_setup.sensor_limits import contact_force_for
+from robot_setup.tip_response import MIN_TIP_ACCELERATION, tip_acceleration
 
 # Plan, RobotSpec, command_line and recorded_command live in robot_setup.plan (the templates read them too);
 # named here as well, where the tests and tests/robot_packages import them.
@@ -315,13 +317,18 @@ def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
     kp = tuple(_round(min(KP_MAX, max(KP_MIN, KP_PER_NM * e)), 100.0) if e > 0 else KP_MIN for e in efforts)
     kv = tuple(_round(k * KV_RATIO, 1.0) for k in kp)
     armature = 0.2 if max(efforts) > 100.0 else 0.1
+    per_joint = tip_acceleration(arm, q0, 1.0)  # [m/s^2 per rad/s^2]
+    acceleration = max(JogSettings.default_max_acceleration,
+                       math.ceil(MIN_TIP_ACCELERATION / per_joint * 2.0) / 2.0)
+    log(f"[robot] jog_arm: joint acceleration limit {acceleration:g} rad/s^2, the tip at least "
+        f"{acceleration * per_joint:.2f} m/s^2 along X, Y and Z at the start pose")
     plan = Plan(
         spec=spec, source=source, removed=removed, base=base, tool_rpy=rpy, adapter=adapter, held=held,
         servo_joints=servo_joints, urdf_xml=urdf_xml, joints=arm.joint_names,
         reach=reach, geometry=geometry, gap=gap, obstacle_size=obstacle_size,
         obstacle_position=obstacle_position, start=start, tip_in_base=tip_in_base, home=home,
         threshold=threshold, hard_stop=hard_stop,
-        kp=kp, kv=kv, armature=armature, efforts=tuple(efforts), driver=driver,
+        kp=kp, kv=kv, armature=armature, efforts=tuple(efforts), driver=driver, acceleration=acceleration,
     )
     for line in analysis_lines(plan, arm):
         log(f"[robot] {line}")

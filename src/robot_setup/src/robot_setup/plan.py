@@ -141,3 +141,4 @@ class Plan:
     armature: float
     efforts: tuple[float, ...]
     driver: DriverInterface  # the hardware files' driver (generic, or from the DRIVER profile)
+    acceleration: float  # [rad/s^2] jog_arm's joint acceleration limit (default_max_acceleration)

@@ -6,6 +6,7 @@ from __future__ import annotations
 from robot_setup.plan import Plan
 from robot_setup.templates.sim_yaml import held_section
 from robot_setup.templates.text import generated_by
+from robot_setup.tip_response import MIN_TIP_ACCELERATION
 
 __all__ = ["chain", "jog_arm_yaml", "thresholds"]
 
@@ -29,6 +30,9 @@ def thresholds(plan: Plan) -> str:
 singularity_threshold: {plan.threshold:g}
 hard_stop_singularity_threshold: {plan.hard_stop:g}
 singularity_length_scale: 0.4       # [m] jog_arm's default, stated because the thresholds depend on it
+# Every joint's acceleration limit: the tip can accelerate at least {MIN_TIP_ACCELERATION:g} m/s^2 along X, Y and Z at the start
+# pose (make robot; a smaller arm needs more, robot_setup README).
+default_max_acceleration: {plan.acceleration:.1f}       # [rad/s^2]
 """
 
 

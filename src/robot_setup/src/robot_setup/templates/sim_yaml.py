@@ -69,7 +69,7 @@ servo:
   kv:                      # [Nm s/rad]
 {joints(plan.kv, plan.servo_joints, "{:.1f}", 4)}
   armature: {plan.armature}            # reflected rotor inertia per joint [kg m^2]
-  max_acceleration: 4.0    # [rad/s^2] setpoint acceleration limit (above jog_arm's 3 rad/s^2)
+  max_acceleration: {plan.acceleration + 1.0:.1f}    # [rad/s^2] setpoint acceleration limit (above jog_arm's {plan.acceleration:g} rad/s^2)
   payload_feedforward: true
 
 wrench_noise:              # Gaussian sensor noise (0: exact)
