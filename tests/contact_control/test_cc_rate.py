@@ -98,3 +98,25 @@ def test_sample_period_ignores_dropouts_repeats_and_jumps():
     changes = [period.add(t) for t in times]
     assert period.period == pytest.approx(0.01)
     assert sum(changes) == 1
+
+
+def test_a_bursty_publisher_is_measured_at_its_mean_rate_and_one_stall_changes_nothing():
+    """A starved process publishing a 500 Hz sensor in bursts (stamped at publish time): the median interval
+    read 168-370 Hz under CI's load and redesigned the filter each window; the mean does not move."""
+    period = SamplePeriod(window=32)
+    t, times = 0.0, []
+    for burst in range(40):  # 10 samples 0.1 ms apart, then the 19.1 ms the process was away: 500 Hz
+        times += [t + k * 0.0001 for k in range(10)]
+        t += 0.02
+    seen = [period.period for x in times if period.add(x)]
+    # Within the 10 % that makes contact_control redesign its filter (a window holds 3.2 bursts: the phase
+    # counts); the median said 0.1 ms.
+    assert seen and all(p == pytest.approx(0.002, rel=0.1) for p in seen), seen
+    steady = period.period
+    stalled = [t + k * 0.002 for k in range(16)] + [t + 0.1 + k * 0.002 for k in range(16)]  # a 70 ms stall
+    assert not any(period.add(x) for x in stalled)
+    assert period.period == steady
+    later = stalled[-1] + 0.002
+    for k in range(96):  # a sensor that really changed rate (to 100 Hz) is taken after two windows of it
+        period.add(later + k * 0.01)
+    assert period.period == pytest.approx(0.01)
