@@ -105,7 +105,7 @@ def test_a_bursty_publisher_is_measured_at_its_mean_rate_and_one_stall_changes_n
     read 168-370 Hz under CI's load and redesigned the filter each window; the mean does not move."""
     period = SamplePeriod(window=32)
     t, times = 0.0, []
-    for burst in range(40):  # 10 samples 0.1 ms apart, then the 19.1 ms the process was away: 500 Hz
+    for _burst in range(40):  # 10 samples 0.1 ms apart, then the 19.1 ms the process was away: 500 Hz
         times += [t + k * 0.0001 for k in range(10)]
         t += 0.02
     seen = [period.period for x in times if period.add(x)]
