@@ -39,4 +39,3 @@ def tip_acceleration(arm: ArmModel, q: np.ndarray, joint_acceleration: float) ->
     limit (every joint: `joint_acceleration` [rad/s^2]) allows at `q`."""
     worst = max(float(np.max(np.abs(joint_rates(arm, q, axis)))) for axis in np.eye(3))
     return joint_acceleration / worst
-
