@@ -18,7 +18,7 @@ from contact_control.axes import (
     LAW_FORCE_TRACKING,
     SAFETY_OK,
 )
-from contact_control.laws import AxisLaw, law_velocity, shape_velocity
+from contact_control.laws import AxisLaw, guard_pressing, law_velocity, shape_velocity
 from contact_control.params import load_settings
 from contact_control.request import (
     SET_CARTESIAN_CONTROL_FAILED,
@@ -95,6 +95,74 @@ def test_presses_with_the_target_force_and_holds_it():
     assert loop.pose[2, 3] < TABLE_Z  # it is in the table by TARGET / STIFFNESS
     assert loop.pose[2, 3] == pytest.approx(TABLE_Z - TARGET / STIFFNESS, abs=0.2 / STIFFNESS + 1e-6)
 
+
+
+def test_the_unfiltered_force_caps_pressing_and_never_pulls_back():
+    # In contact by the unfiltered force (>= half the target): at most (F_target - F) / b, deadband as in the
+    # law; at or past the target's band nothing presses.
+    assert guard_pressing(PRESS, TUNING, -0.01, 6.0) == pytest.approx(-3.8 / B)
+    assert guard_pressing(PRESS, TUNING, -0.01, 9.9) == 0.0
+    assert guard_pressing(PRESS, TUNING, -0.01, 30.0) == 0.0
+    # A slower press than the cap is kept; pulling back is the filtered law's alone (noise cannot make the
+    # axis retreat); out of contact by the unfiltered force the approach is untouched.
+    assert guard_pressing(PRESS, TUNING, -0.0005, 6.0) == -0.0005
+    assert guard_pressing(PRESS, TUNING, 0.002, 30.0) == 0.002
+    assert guard_pressing(PRESS, TUNING, -0.01, 4.9) == -0.01
+    # Pressing up against a ceiling: the mirror image; no target, no contact to guard.
+    up = replace(PRESS, target=-TARGET)
+    assert guard_pressing(up, TUNING, 0.01, -6.0) == pytest.approx(3.8 / B)
+    assert guard_pressing(up, TUNING, 0.01, -12.0) == 0.0
+    assert guard_pressing(up, TUNING, -0.002, -30.0) == -0.002
+    assert guard_pressing(replace(PRESS, target=0.0), TUNING, -0.01, 50.0) == -0.01
+
+
+def touch(guard: bool, stiffness: float = 60000.0) -> tuple[np.ndarray, ClosedLoop]:
+    """Presses at 5 mm/s on a table `stiffness` [N/m] stiff (the arm 10 ms late); the true force per cycle."""
+    true: list[float] = []
+
+    def stiff_table(t, pose):
+        depth = TABLE_Z - pose[2, 3]
+        true.append(stiffness * depth if depth > 0.0 else 0.0)
+        return [0.0, 0.0, true[-1], 0.0, 0.0, 0.0]
+
+    loop = ClosedLoop(controller(force_tracking_fast_guard=guard), lag=0.01)
+    loop.start(laws(z=replace(PRESS, velocity=0.005)))
+    loop.run(stiff_table, 4.0)
+    return np.array(true), loop
+
+
+def test_touching_a_stiff_surface_stops_pressing_before_the_filter_has_seen_the_contact():
+    # 60 N/mm, three times the README's arm on a table (the simulated SO-100 and UR3 on their blocks measured
+    # 90-130 N/mm): the 5 Hz filter's 45 ms delay let the approach run on.
+    unguarded, _ = touch(False)
+    assert unguarded.max() > 20.0  # what tripped the SO-100's limits
+    true, loop = touch(True)
+    assert true.max() < 12.0
+    contact = int(np.argmax(true > 0.0))
+    held = true[contact + round(1.0 / DT):]  # a second after touching: on the target, and staying there
+    assert np.all(np.abs(held - TARGET) <= TOLERANCE), (held.min(), held.max())
+    assert loop.results[-1].move_active
+    # Without the guard the same loop never settles: it bounces on the table.
+    assert np.ptp(unguarded[contact + round(1.0 / DT):]) > 5.0
+
+
+def test_noise_on_the_unfiltered_force_barely_moves_the_held_force():
+    # A UR e-series wrench's noise (0.2-0.6 N, ../shared/realdata) at 2 N: the guard only ever slows pressing,
+    # so the true force settles a little low, within the law's deadband.
+    rng = np.random.default_rng(7)
+    true: list[float] = []
+
+    def noisy_table(t, pose):
+        depth = TABLE_Z - pose[2, 3]
+        true.append(STIFFNESS * depth if depth > 0.0 else 0.0)
+        return [0.0, 0.0, true[-1] + rng.normal(0.0, 2.0), 0.0, 0.0, 0.0]
+
+    loop = ClosedLoop(controller(), lag=0.02)
+    loop.start(laws(z=PRESS))
+    loop.run(noisy_table, 6.0)
+    held = np.array(true[-round(3.0 / DT):])
+    assert held.mean() == pytest.approx(TARGET, abs=0.3)
+    assert np.all(np.abs(held - TARGET) <= 2 * TOLERANCE), (held.min(), held.max())
 
 def press_then_move_x(slope: float) -> tuple[ClosedLoop, float]:
     """Presses for 3 s, then adds an X compliant move (0.02 m/s) for 3 s; returns the loop and X's start."""

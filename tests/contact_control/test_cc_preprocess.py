@@ -98,6 +98,21 @@ def test_frame_change_includes_the_lever_arm(pose, sensor, control):
     assert w == pytest.approx(control, abs=1e-12)
 
 
+
+@pytest.mark.parametrize(("pose", "sensor", "control"), FRAMES)
+def test_the_fast_wrench_is_the_unfiltered_one_in_the_control_frame(pose, sensor, control):
+    # What force tracking's pressing guard reads: the sample before the low-pass, moved to the control frame
+    # like the filtered one, no deadband; the filtered result has barely started to move.
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = pose
+    pre = WrenchPreprocessor(load_settings({"force_deadband": 5.0}))
+    pre.keep_fast = True
+    pre.process([0.0] * 6, T)  # the filter starts from its first sample: at rest, then the step
+    code, w = pre.process(sensor, T)
+    assert code == SAFETY_OK
+    assert pre.fast == pytest.approx(control, abs=1e-12)
+    assert max(abs(v) for v in w) < 0.1 * max(abs(v) for v in control)
+
 def test_sign_flags_flip_force_and_torque_of_their_axis():
     pre = WrenchPreprocessor(
         load_settings({"lp_filter_enabled": False, "ft_x_direction": -1, "ft_z_direction": -1})

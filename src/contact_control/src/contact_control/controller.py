@@ -51,7 +51,15 @@ from contact_control.axes import (
 )
 from contact_control.drift import ZeroDrift
 from contact_control.exceeded import ExceededReaction
-from contact_control.laws import AxisLaw, ForceWindow, check_end, law_velocity, path_velocity, shape_velocity
+from contact_control.laws import (
+    AxisLaw,
+    ForceWindow,
+    check_end,
+    guard_pressing,
+    law_velocity,
+    path_velocity,
+    shape_velocity,
+)
 from contact_control.loop_gain import GainBound
 from contact_control.noise_floor import NoiseFloor
 from contact_control.oscillation import OscillationWatch, halved
@@ -212,6 +220,7 @@ class ContactControl:
         self._diff_axes: tuple[int, ...] = ()
         self._needs_travel = False
         self._floor = [True] * 6  # per axis: zero commands below min velocity (not for force tracking, path)
+        self._guarded = [False] * 6  # per axis: force tracking with the pressing guard (fast_guard)
         self._path = PathReference(s.path_reference_timeout, s.path_extrapolate)
         self._path_axes: tuple[int, ...] = ()
         self._is_path = [False] * 6
@@ -418,6 +427,9 @@ class ContactControl:
         self._diff_axes = tuple(i for i in self._active if self._diff[i] > 0.0)
         self._needs_travel = any(law.law not in _NO_TRAVEL or law.max_travel > 0.0 for law in laws if law.law)
         self._floor = [law.law not in (LAW_FORCE_TRACKING, LAW_PATH) for law in laws]
+        self._guarded = [self.settings.force_tracking_fast_guard and law.law == LAW_FORCE_TRACKING
+                         and law.target != 0.0 for law in laws]
+        self.preprocessor.keep_fast = any(self._guarded)
         self._is_path = [law.law == LAW_PATH for law in laws]
         self._path_axes = tuple(i for i in self._active if self._is_path[i])
         self._watched = tuple(i for i in self._active if not self._is_path[i])
@@ -670,11 +682,14 @@ class ContactControl:
         dt = self._dt_nominal if last is None else min(max(t - last, 0.0), self._timeout)
         self._last_t = t
         v, tuning, floor = self._v, self._tuning, self._floor
+        guarded, fast = self._guarded, self.preprocessor.fast
         for i in self._active:
             if is_path[i]:
                 target = path_velocity(laws[i], tuning[i], w[i], error[i], self._path_velocity[i])
             else:
                 target = law_velocity(laws[i], tuning[i], w[i], travel[i])
+                if guarded[i]:
+                    target = guard_pressing(laws[i], tuning[i], target, fast[i])
             v[i] = shape_velocity(target, v[i], tuning[i], dt, floor[i])
         watch = self._watch
         if watch is not None:

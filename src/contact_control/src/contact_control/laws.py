@@ -47,7 +47,8 @@ from contact_control.axes import (
 from contact_control.params import AxisTuning
 
 __all__ = [
-    "AxisLaw", "ForceWindow", "check_end", "law_velocity", "path_velocity", "round_to", "shape_velocity",
+    "AxisLaw", "ForceWindow", "check_end", "guard_pressing", "law_velocity", "path_velocity", "round_to",
+    "shape_velocity",
 ]
 
 
@@ -128,6 +129,26 @@ def law_velocity(law: AxisLaw, tuning: AxisTuning, force: float, travel: float) 
             return law.velocity
         return v
     return 0.0
+
+
+def guard_pressing(law: AxisLaw, tuning: AxisTuning, v: float, fast: float) -> float:
+    """Force tracking's velocity `v` with its pressing (toward the contact) capped by the unfiltered force
+    `fast`: once that is in contact (past `contact_fraction` of the target), at most (F_target - fast) / b
+    (deadband as in the law), 0 past the target. It never pulls back (that stays with the filtered force, so
+    noise cannot make it retreat): a touch stops the pressing a filter delay sooner (README, *Force
+    tracking*)."""
+    target = law.target
+    if target > 0.0:
+        if v >= 0.0 or fast < tuning.contact_fraction * target:
+            return v
+        cap = (fast - target + tuning.track_deadband) / law.damping  # < 0 while short of the target's band
+        return max(v, min(cap, 0.0))
+    if target < 0.0:
+        if v <= 0.0 or fast > tuning.contact_fraction * target:
+            return v
+        cap = (fast - target - tuning.track_deadband) / law.damping
+        return min(v, max(cap, 0.0))
+    return v
 
 
 def path_velocity(law: AxisLaw, tuning: AxisTuning, force: float, error: float, reference: float) -> float:

@@ -254,6 +254,10 @@ class ContactControlSettings:
         doc="force tracking is out of contact, and approaches at its approach speed, while F is "
         "short of this fraction of the target",
     )
+    force_tracking_fast_guard: bool = param(
+        True, doc="force tracking never presses faster than (F_target - F) / b with F unfiltered once that F "
+        "is in contact: a touch stops the pressing before the low-pass filter has seen it",
+    )
     # path law (ConfigureLaws PATH, fed by ~path_reference)
     path_reference_timeout: float = _pos(
         0.25, "s", "a path law's move ends (PATH_LOST) when no ~path_reference came for this long"

@@ -61,6 +61,10 @@ class WrenchPreprocessor:
         self.set_limits(settings.global_max_force, settings.global_max_torque)
         self.set_deadband(settings.force_deadband, settings.torque_deadband)
         self._filter: LowPass | None = None
+        # The last sample unfiltered, in the control frame (what `process` gives before the low-pass, no
+        # deadband), kept while `keep_fast` is set: force tracking's pressing guard reads it.
+        self.keep_fast = False
+        self.fast = [0.0] * 6
         self._cutoff = settings.lp_filter_cutoff_freq
         self.design_period = settings.lp_filter_delta_t  # [s] the filter's current design sample period
         if settings.lp_filter_enabled:
@@ -244,22 +248,13 @@ class WrenchPreprocessor:
             fx, fy, fz, tx, ty, tz = fx - g[0], fy - g[1], fz - g[2], tx - g[3], ty - g[4], tz - g[5]
         if fx * fx + fy * fy + fz * fz > self._fmax2 or tx * tx + ty * ty + tz * tz > self._tmax2:
             return SAFETY_OVER_LIMIT, [fx, fy, fz, tx, ty, tz]
+        m = None if T_control_sensor is None else as_rows(T_control_sensor)
+        if self.keep_fast:
+            self.fast[:] = (fx, fy, fz, tx, ty, tz) if m is None else _to_control(m, fx, fy, fz, tx, ty, tz)
         if self._filter is not None:
             fx, fy, fz, tx, ty, tz = self._filter.step((fx, fy, fz, tx, ty, tz))
-        if T_control_sensor is not None:
-            m = as_rows(T_control_sensor)
-            r0, r1, r2 = m[0], m[1], m[2]
-            px, py, pz = r0[3], r1[3], r2[3]
-            cfx = r0[0] * fx + r0[1] * fy + r0[2] * fz
-            cfy = r1[0] * fx + r1[1] * fy + r1[2] * fz
-            cfz = r2[0] * fx + r2[1] * fy + r2[2] * fz
-            # Torque about the reference origin: rotated sensor torque plus lever arm p x F.
-            tx, ty, tz = (
-                r0[0] * tx + r0[1] * ty + r0[2] * tz + py * cfz - pz * cfy,
-                r1[0] * tx + r1[1] * ty + r1[2] * tz + pz * cfx - px * cfz,
-                r2[0] * tx + r2[1] * ty + r2[2] * tz + px * cfy - py * cfx,
-            )
-            fx, fy, fz = cfx, cfy, cfz
+        if m is not None:
+            fx, fy, fz, tx, ty, tz = _to_control(m, fx, fy, fz, tx, ty, tz)
         out = [fx, fy, fz, tx, ty, tz]
         if self._deadband:
             dbf, dbt = self._db_force, self._db_torque
@@ -269,3 +264,21 @@ class WrenchPreprocessor:
                 if -dbt < out[i + 3] < dbt:
                     out[i + 3] = 0.0
         return SAFETY_OK, out
+
+
+def _to_control(
+    m: Sequence[Sequence[float]], fx: float, fy: float, fz: float, tx: float, ty: float, tz: float
+) -> tuple[float, float, float, float, float, float]:
+    """A sensor-frame wrench in the control frame (`m`: T_control_sensor's rows), torque about its origin."""
+    r0, r1, r2 = m[0], m[1], m[2]
+    px, py, pz = r0[3], r1[3], r2[3]
+    cfx = r0[0] * fx + r0[1] * fy + r0[2] * fz
+    cfy = r1[0] * fx + r1[1] * fy + r1[2] * fz
+    cfz = r2[0] * fx + r2[1] * fy + r2[2] * fz
+    # Torque about the reference origin: rotated sensor torque plus lever arm p x F.
+    return (
+        cfx, cfy, cfz,
+        r0[0] * tx + r0[1] * ty + r0[2] * tz + py * cfz - pz * cfy,
+        r1[0] * tx + r1[1] * ty + r1[2] * tz + pz * cfx - px * cfz,
+        r2[0] * tx + r2[1] * ty + r2[2] * tz + px * cfy - py * cfx,
+    )
