@@ -101,6 +101,7 @@ class ContactStage:
         # T_control_sensor, R_world_sensor of that wrench
         self._last_frames: tuple[Rows | None, Rows | None] = (None, None)
         self._have_frames = False
+        self._tf_missing = ""  # why the last wrench had no transform ("": it had them)
         self._last_t = 0.0
         #: The latest compensated, unfiltered contact force ((fx, fy, fz) [N], control frame, t [s]) or None.
         self.contact: tuple[tuple[float, float, float], str, float] | None = None
@@ -172,7 +173,14 @@ class ContactStage:
         try:
             T_cs, R_ws, eef, R_fc, R_cc = self._frames(sensor_frame)
         except LookupError as err:
-            return self._emit(self.ctrl.hold(t, SAFETY_NO_TF, f"no transform: {err}"))
+            why = f"no transform: {err}"
+            if why != self._tf_missing:  # logged once per change: only ~status said so before
+                self.notes.append(("warn", f"{why}: holding (zero twist) until it comes"))
+                self._tf_missing = why
+            return self._emit(self.ctrl.hold(t, SAFETY_NO_TF, why))
+        if self._tf_missing:
+            self.notes.append(("info", "transforms available again"))
+            self._tf_missing = ""
         velocity = self._emit(self.ctrl.update(wrench, t, T_cs, R_ws, eef, R_fc, stamp), R_cc)
         if self.ctrl.notes:  # the sensor's measured rate, once per change
             self.notes.extend(("warn", note) for note in self.ctrl.notes)
