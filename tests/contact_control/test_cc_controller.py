@@ -23,6 +23,7 @@ from contact_control.axes import (
     SAFETY_STALE,
 )
 from contact_control.laws import AxisLaw
+from contact_control.params import load_settings
 from contact_control.request import RequestError, empty_request, validate_request
 
 FOLLOWER = AxisLaw(LAW_FOLLOWER, damping=30.0)
@@ -206,9 +207,54 @@ def test_compliant_move_slows_down_and_ends_at_max_travel():
     v = loop.velocities()[:, 0]
     travel = np.array([r.travel[0] for r in loop.results])
     assert loop.results[-1].end_conditions[0] == END_MAX_TRAVEL and not loop.results[-1].move_active
-    assert 0.1 <= loop.pose[0, 3] < 0.1 + 0.02 * DT * 2
+    # Then it coasts to rest over end_stop_time (0.05 s) from ~0.02 m/s: 0.5 mm further.
+    assert 0.1 <= loop.pose[0, 3] < 0.1 + 0.02 * (END_STOP / 2 + 2 * DT)
     assert v[travel > 0.099].max() <= 0.025  # slows to about the approach speed before the end
     assert v.max() == pytest.approx(0.1)
+
+
+END_STOP = load_settings({}).end_stop_time
+
+
+def ended_at(loop: ClosedLoop) -> int:
+    return next(i for i, r in enumerate(loop.results) if not r.move_active)
+
+
+def test_a_move_ended_by_its_max_travel_coasts_to_rest_and_a_fault_stops_at_once():
+    """Stopped at once, a tool sliding on the simulated UR3's block kicked |F| from 14 to 23 N (of the 25 N
+    global limit); over 50 ms, not at all. A normal end slows down linearly over end_stop_time, published
+    (`commanding`), never faster; a force limit, the global limit or a stop still stop at once."""
+    slide = laws(x=AxisLaw(LAW_COMPLIANT_MOVE, velocity=0.01, max_travel=0.01))
+    loop = ClosedLoop(controller())
+    loop.start(slide)
+    loop.run([0.0] * 6, 1.5)
+    end = ended_at(loop)
+    v = loop.velocities()[end:, 0]
+    steps = round(END_STOP / DT)
+    assert v[0] == pytest.approx(0.01) and np.all(np.diff(v) <= 1e-12), v[:5]
+    assert v[steps // 2] == pytest.approx(0.005, abs=0.0005)  # halfway down halfway through
+    assert v[steps + 1:].max() == 0.0
+    assert all(r.commanding for r in loop.results[end:end + steps - 1])
+    assert not loop.results[-1].commanding and loop.results[-1].end_conditions[0] == END_MAX_TRAVEL
+    assert loop.pose[0, 3] == pytest.approx(0.01 + 0.01 * END_STOP / 2, abs=0.01 * 2 * DT)
+    # 0: at once, as before.
+    instant = ClosedLoop(controller(end_stop_time=0.0))
+    instant.start(slide)
+    instant.run([0.0] * 6, 1.5)
+    assert instant.velocities()[ended_at(instant):, 0].max() == 0.0
+    # A force limit is a contact: at once, whatever the speed.
+    pressed = ClosedLoop(controller())
+    pressed.start(laws(x=AxisLaw(LAW_COMPLIANT_MOVE, velocity=0.01, force_limit=2.0)))
+    pressed.run(wall(0.005, axis=0, sign=1.0), 1.5)
+    assert pressed.results[ended_at(pressed)].end_conditions[0] == END_FT_VIOLATION
+    assert pressed.velocities()[ended_at(pressed):, 0].max() == 0.0
+    # The global limit during the coast: at once.
+    tripped = ClosedLoop(controller())
+    tripped.start(slide)
+    tripped.run([0.0] * 6, 1.0 + 0.2 * END_STOP)  # the move ends at 1.0 s (0.01 m at 0.01 m/s)
+    assert tripped.velocities()[-1, 0] > 0.0  # coasting
+    tripped.run([0.0, 0.0, 100.0, 0.0, 0.0, 0.0], 4 * DT)
+    assert tripped.results[-1].velocity == [0.0] * 6 and tripped.results[-1].safety != 0
 
 
 def test_hybrid_move_ends_the_spring_too():

@@ -919,10 +919,14 @@ class ContactControl:
             why = f"travel |{self._travel[axis]:.4g}| reached the max path deviation {law.max_travel}"
         else:
             why = f"force changed by more than {self._diff[axis]} within the window"
+        kept = self._v
         self._end_move(axis, condition, True, f"axis {name}: {END_NAMES[condition]}: {why}")
         if condition == END_FT_VIOLATION and self._reaction.start(self._laws, self._wrench):
             for i in self._reaction.follower_axes():
                 self._law_types[i] = LAW_FOLLOWER  # gravity compensation: what the axis runs now
+        elif condition == END_MAX_TRAVEL and self._reaction.coast(kept, self.settings.end_stop_time):
+            self._v = kept  # from this cycle's velocity to rest over end_stop_time (exceeded.py)
+            return self._result(t, SAFETY_OK, "")
         return self._hold(t, SAFETY_OK, "")
 
     def _react(self, t: float, w: list[float]) -> CycleResult:

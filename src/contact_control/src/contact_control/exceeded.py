@@ -10,6 +10,10 @@
 - gravity_compensation: the axis becomes a follower with its own damping (V = F / b, with the follower
   deadband): hand-guiding in that direction until `~stop`, a new request or a safety stop.
 
+- (any law) coasting: a move that ended on its max travel, its normal end, slows its axes to rest over
+  `end_stop_time` instead of stopping at once (`coast`): a tool sliding on a surface and stopped at once
+  kicked the contact force up (README, *End conditions*).
+
 The velocities go through the same shaping (minimum velocity, clamp, acceleration and deceleration limits,
 immediate stop on reversal) as the laws', so a reaction never moves faster than a law could. Pure: no rospy.
 """
@@ -48,6 +52,7 @@ class ExceededReaction:
         self._mode = [_IDLE] * 6
         self._laws: list[AxisLaw] = [AxisLaw()] * 6
         self._moved = [0.0] * 6
+        self._coast = [0.0] * 6  # per axis: its deceleration to rest [m/s^2, rad/s^2] (0: none)
 
     def retune(self, tuning: Sequence[AxisTuning]) -> None:
         """New limits (live tuning); a running reaction goes on with them."""
@@ -66,8 +71,8 @@ class ExceededReaction:
         return _AWAY in self._mode
 
     def reacting(self) -> list[bool]:
-        """Per axis: carrying out its exceeded action (backing off or hand-guided)."""
-        return [mode != _IDLE for mode in self._mode]
+        """Per axis: carrying out its exceeded action (backing off or hand-guided), or coasting to rest."""
+        return [mode != _IDLE or coast > 0.0 for mode, coast in zip(self._mode, self._coast, strict=True)]
 
     def follower_axes(self) -> list[int]:
         """Axes under gravity compensation (they run the follower law)."""
@@ -83,6 +88,17 @@ class ExceededReaction:
         self._mode = [_IDLE] * 6
         self._notes = []
         self._moving = False
+        self._coast = [0.0] * 6
+
+    def coast(self, velocity: Sequence[float], duration: float) -> bool:
+        """Slows the axes from `velocity` to rest over `duration` [s], each at a constant deceleration (not
+        through the minimum velocity, which would stop one at once below it); returns whether any moves."""
+        self.clear()
+        if duration <= 0.0:
+            return False
+        self._coast = [abs(v) / duration for v in velocity]
+        self._moving = any(self._coast)
+        return self._moving
 
     def start(self, laws: Sequence[AxisLaw], wrench: Sequence[float]) -> bool:
         """Starts the reactions of a move that ended on a force limit; returns whether any axis reacts.
@@ -136,7 +152,14 @@ class ExceededReaction:
                                       f"but |F| is still {abs(force):.3g} {unit}: holding")
                 else:
                     target = math.copysign(tuning.away_velocity, force)  # along the force: off the contact
-            v = shape_velocity(target, velocity[i], tuning, dt)
+            rate = self._coast[i]
+            if rate > 0.0:
+                before, step = velocity[i], rate * dt
+                v = 0.0 if abs(before) <= step else before - math.copysign(step, before)
+                if v == 0.0:
+                    self._coast[i] = 0.0
+            else:
+                v = shape_velocity(target, velocity[i], tuning, dt)
             velocity[i] = v
             self._moved[i] += abs(v) * dt
             moving = moving or v != 0.0

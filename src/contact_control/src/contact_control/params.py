@@ -208,6 +208,10 @@ class ContactControlSettings:
     deceleration_angular: float = _pos(2.5, "rad/s^2", "same for rotations")
     spring_output_scale: float = _pos(0.2, "", "spring velocity factor (fork: 0.2)")
     spring_rounding: float = _nonneg(0.01, "N, m/s", "spring rounds force and velocity to this step (0: off)")
+    end_stop_time: float = _nonneg(
+        0.05, "s", "a move that ends on its max travel (its normal end, not a fault) slows to rest over this "
+        "long instead of stopping at once (0: at once; README, End conditions)",
+    )
     compliant_slowdown_distance: float = _nonneg(0.02, "m", "compliant move slows down this near max travel")
     compliant_slowdown_angle: float = _nonneg(0.02, "rad", "same for rotations")
     compliant_approach_speed_linear: float = param(
