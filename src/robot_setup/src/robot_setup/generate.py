@@ -27,8 +27,10 @@ import os
 import sys
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 
 import numpy as np
+import yaml
 from compliant_common.errors import StackError
 from control_stack.description import (
     ERD_PACKAGE,
@@ -39,7 +41,7 @@ from control_stack.description import (
 )
 from jog_arm.kinematics import ArmModel
 from jog_arm.settings import JogSettings
-from thesis_demos.geometry import SURFACE_TRAVEL, DemoGeometry, demo_motions
+from thesis_demos.geometry import SURFACE_DIRECTION, SURFACE_TRAVEL, DemoGeometry, demo_motions
 from thesis_demos.scenarios import HYBRID_PUSH_DURATION, HYBRID_PUSH_START
 
 from robot_setup import templates
@@ -62,6 +64,7 @@ from robot_setup.plan import (
     recorded_command,
 )
 from robot_setup.sensor_limits import contact_force_for
+from robot_setup.slide_check import CHATTER_STD, servo_scale
 from robot_setup.tip_response import MIN_TIP_ACCELERATION, tip_acceleration
 
 # Plan, RobotSpec, command_line and recorded_command live in robot_setup.plan (the templates read them too);
@@ -330,9 +333,29 @@ def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
         threshold=threshold, hard_stop=hard_stop,
         kp=kp, kv=kv, armature=armature, efforts=tuple(efforts), driver=driver, acceleration=acceleration,
     )
+    plan = _settle_servos(plan, log)
     for line in analysis_lines(plan, arm):
         log(f"[robot] {line}")
     return plan
+
+
+def _settle_servos(plan: Plan, log: Callable[[str], object]) -> Plan:
+    """The servo gains lowered (kp and kv alike) until the tool slides cleanly on the block
+    (`robot_setup.slide_check`); the plan as it was when it does at the effort rule's gains."""
+    scene = yaml.safe_load(templates.render(plan, [])["config/sim.yaml"])
+    scale, first, taken = servo_scale(plan.urdf_xml, scene, plan.joints, SURFACE_DIRECTION, KP_MIN)
+    if scale == 1.0:
+        if not first.clean:
+            log(f"[robot] sim: the tool chatters on the block while sliding (force std {first.std:.2f} N, "
+                f"over {CHATTER_STD:g}) at every servo gain down to kp {KP_MIN:g}: surface following may "
+                "fail")
+        return plan
+    kp = tuple(_round(k * scale, 100.0) for k in plan.kp)
+    kv = tuple(_round(k * KV_RATIO, 1.0) for k in kp)
+    note = (f"x{scale:g}: at the effort rule's gains the tool chattered on the block while sliding (force "
+            f"std {first.std:.2f} N, {taken.std:.2f} N now; robot_setup.slide_check)")
+    log(f"[robot] sim: servo gains {note}")
+    return replace(plan, kp=kp, kv=kv, servo_note=note)
 
 
 def analysis_lines(plan: Plan, arm: ArmModel | None = None) -> list[str]:

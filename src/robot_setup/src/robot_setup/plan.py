@@ -142,3 +142,4 @@ class Plan:
     efforts: tuple[float, ...]
     driver: DriverInterface  # the hardware files' driver (generic, or from the DRIVER profile)
     acceleration: float  # [rad/s^2] jog_arm's joint acceleration limit (default_max_acceleration)
+    servo_note: str = ""  # why kp and kv are below the effort rule's ("": they are not)

@@ -25,6 +25,11 @@ def held_section(plan: Plan, indent: int = 0) -> str:
 """
 
 
+def servo_note(plan: Plan) -> str:
+    """Why the gains are lower than the rule's, as the comment's tail ("" when they are not)."""
+    return f";\n# then {plan.servo_note}" if plan.servo_note else ""
+
+
 def sim_yaml(plan: Plan) -> str:
     name = plan.spec.name
     s = plan.start
@@ -62,7 +67,7 @@ obstacle:
   rpy: [0.0, 0.0, 0.0]              # [rad]
 
 # Joint servos: torque = kp (q_set - q) + kv (qd_set - qd) + payload feed-forward, limited to the URDF
-# efforts ({', '.join(num(e) for e in plan.efforts)} Nm). kp = 120 Nm/rad per Nm of effort (1000..20000), kv = 0.02 s x kp.
+# efforts ({', '.join(num(e) for e in plan.efforts)} Nm). kp = 120 Nm/rad per Nm of effort (1000..20000), kv = 0.02 s x kp{servo_note(plan)}.
 servo:
   kp:                      # [Nm/rad]
 {joints(plan.kp, plan.servo_joints, "{:.1f}", 4)}
