@@ -257,6 +257,20 @@ def test_a_move_ended_by_its_max_travel_coasts_to_rest_and_a_fault_stops_at_once
     assert tripped.results[-1].velocity == [0.0] * 6 and tripped.results[-1].safety != 0
 
 
+
+def test_live_tuning_during_the_coast_still_brings_the_axis_to_rest():
+    """Retuning reset the reaction's moving flag: a coasting axis kept its last velocity, published, for ever."""
+    from dataclasses import replace
+
+    ctrl = controller()
+    loop = ClosedLoop(ctrl)
+    loop.start(laws(x=AxisLaw(LAW_COMPLIANT_MOVE, velocity=0.01, max_travel=0.01)))
+    loop.run([0.0] * 6, 1.0 + 0.2 * END_STOP)
+    assert not loop.results[-1].move_active and loop.velocities()[-1, 0] > 0.0  # coasting
+    ctrl.retune(replace(ctrl.settings, max_velocity=0.2))
+    loop.run([0.0] * 6, 0.5)
+    assert loop.velocities()[-1, 0] == 0.0 and not loop.results[-1].commanding
+
 def test_hybrid_move_ends_the_spring_too():
     # Thesis hybrid demo: compliant move on X (0.30 m, 0.5 N) with a spring on Z; Z is held pushed down.
     loop = ClosedLoop(controller())

@@ -62,8 +62,8 @@ class ExceededReaction:
 
     @property
     def active(self) -> bool:
-        """An axis is moving away, hand-guided, or still slowing down after moving away."""
-        return self._moving or any(self._mode)
+        """An axis is moving away, hand-guided, coasting to rest, or still slowing down after moving away."""
+        return self._moving or any(self._mode) or any(self._coast)
 
     @property
     def moving_away(self) -> bool:
