@@ -259,7 +259,7 @@ def test_a_move_ended_by_its_max_travel_coasts_to_rest_and_a_fault_stops_at_once
 
 
 def test_live_tuning_during_the_coast_still_brings_the_axis_to_rest():
-    """Retuning reset the reaction's moving flag: a coasting axis kept its last velocity, published, for ever."""
+    """Retuning reset the reaction's moving flag: a coasting axis kept its last velocity, published."""
     from dataclasses import replace
 
     ctrl = controller()
