@@ -6,11 +6,11 @@ README, *What make robot decides*).
 Why: at the effort rule's gains (kp 4200 Nm/rad on 35 Nm joints) the SO-100's tool chattered on the block at
 MuJoCo's 2 ms step (contacts 0-4, 3 % of steps none; force std 2.3 N, 3-13 N): the surface-following demo's 50
 ms means reached 11.5-11.75 N of 10 +- 1.5. The same slide at a 0.5 ms step gave 0.5 N: the step does not
-resolve the stiff servo on the light arm against the block. The committed robot packages (UR5, Panda, UR3,
-Jaco2, TIAGo) slide at 0.05-0.21 N; the generated UR5 and UR10 chattered at 2.2-2.5 N (their 50 ms means still
-passed) and slide cleanly at x0.64-0.8. The chatter is not monotonic in the gain (SO-100: clean at x0.25-0.30
-and x0.476, chattering at x0.36-0.44 and x0.5-1.0; x0.41 clean or not with a 0.5 s longer settle), so a gain
-is taken only when 0.9 and 0.8 of it are clean too: in the middle of a clean band.
+resolve the stiff servo on the light arm against the block. The committed robot packages slide at 0.05-0.21 N;
+two larger generated arms chattered at 2.2-2.5 N and slide cleanly at x0.64-0.8 (robot_setup README). The
+chatter is not monotonic in the gain (SO-100: clean at x0.25-0.30 and x0.476, chattering at x0.36-0.44 and
+x0.5-1.0; x0.41 clean or not with a 0.5 s longer settle), so a gain is taken only when 0.9 and 0.8 of it are
+clean too: in the middle of a clean band.
 """
 
 from __future__ import annotations
