@@ -20,7 +20,7 @@ build:
 	@scripts/bootstrap
 
 test: build
-	@$(ENV) python -m pytest $(if $(filter 0,$(PYTEST_WORKERS)),,-n $(PYTEST_WORKERS) --dist loadfile --no-loadscope-reorder) $(PYTEST_ARGS)
+	@$(ENV) python -m pytest $(if $(filter 0,$(PYTEST_WORKERS)),,-n $(PYTEST_WORKERS) --dist loadfile) $(PYTEST_ARGS)
 
 lint: build
 	@$(ENV) ruff check src tests scripts

@@ -10,10 +10,7 @@ import pathlib
 import subprocess
 import sys
 
-import pytest
 from robot_setup.survey import MIN_ARM_JOINTS, Arm, NotAnArm, arms, survey
-
-pytestmark = pytest.mark.long_file  # minutes: started first on the workers (tests/conftest.py)
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 

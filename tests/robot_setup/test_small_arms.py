@@ -15,8 +15,6 @@ from thesis_demos.scenarios import HYBRID_PUSH_DURATION, HYBRID_PUSH_START
 
 from robot_setup import generate
 
-pytestmark = pytest.mark.long_file  # minutes: started first on the workers (tests/conftest.py)
-
 SO100 = RobotSpec("so100", "so_arm_description/urdf/so100.urdf", "gripper")
 HEXTILT = RobotSpec("hextilt", "hextilt_description/urdf/hextilt_flying_arm_5.urdf", "flying_arm_5__gripper")
 LEAST_HYBRID = HYBRID_PUSH_START + HYBRID_PUSH_DURATION + generate.HYBRID_AFTER_PUSH  # [s]

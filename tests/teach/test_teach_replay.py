@@ -24,8 +24,6 @@ from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 from teach.program import Program, ProgramStore, Waypoint
 
-pytestmark = pytest.mark.long_file  # minutes: started first on the workers (tests/conftest.py)
-
 TIP = {"ur5_custom": ("base_link", "tool_tip"), "panda_custom": ("panda_link0", "tool_tip")}
 ROBOT = {"ur5_custom": "ur5", "panda_custom": "panda"}
 

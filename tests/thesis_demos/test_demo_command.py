@@ -7,10 +7,7 @@ import re
 import subprocess
 
 import numpy as np
-import pytest
 from harness.bags import read_bag
-
-pytestmark = pytest.mark.long_file  # minutes: started first on the workers (tests/conftest.py)
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 # The shared VM can freeze processes for 0.1-0.3 s (as in test_demos_e2e): a spoilt run is repeated.
