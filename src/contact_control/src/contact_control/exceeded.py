@@ -97,8 +97,7 @@ class ExceededReaction:
         if duration <= 0.0:
             return False
         self._coast = [abs(v) / duration for v in velocity]
-        self._moving = any(self._coast)
-        return self._moving
+        return self.active
 
     def start(self, laws: Sequence[AxisLaw], wrench: Sequence[float]) -> bool:
         """Starts the reactions of a move that ended on a force limit; returns whether any axis reacts.

@@ -65,6 +65,7 @@ from robot_setup.plan import (
 )
 from robot_setup.sensor_limits import contact_force_for
 from robot_setup.slide_check import CHATTER_STD, servo_scale
+from robot_setup.templates.sim_yaml import sim_yaml
 from robot_setup.tip_response import MIN_TIP_ACCELERATION, tip_acceleration
 
 # Plan, RobotSpec, command_line and recorded_command live in robot_setup.plan (the templates read them too);
@@ -342,10 +343,13 @@ def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
 def _settle_servos(plan: Plan, log: Callable[[str], object]) -> Plan:
     """The servo gains lowered (kp and kv alike) until the tool slides cleanly on the block
     (`robot_setup.slide_check`); the plan as it was when it does at the effort rule's gains."""
-    scene = yaml.safe_load(templates.render(plan, [])["config/sim.yaml"])
+    scene = yaml.safe_load(sim_yaml(plan))
     scale, first, taken = servo_scale(plan.urdf_xml, scene, plan.joints, SURFACE_DIRECTION, KP_MIN)
     if scale == 1.0:
-        if not first.clean:
+        if math.isnan(first.std):  # never pressed
+            log("[robot] sim: the slide check never pressed the tool on the block: servo gains as the rule "
+                "gives them")
+        elif not first.clean:
             log(f"[robot] sim: the tool chatters on the block while sliding (force std {first.std:.2f} N, "
                 f"over {CHATTER_STD:g}) at every servo gain down to kp {KP_MIN:g}: surface following may "
                 "fail")

@@ -15,6 +15,7 @@ clean too: in the middle of a clean band.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -74,7 +75,10 @@ def slide_force_std(
     weight = force_z()
     filtered, pressed_at, slide_at = 0.0, -1.0, -1.0
     seen: list[float] = []
-    deadline = sim.time + 4.0 * float(cfg["obstacle"]["size"][2]) / _APPROACH + 30.0
+    obstacle = cfg["obstacle"]
+    top = float(obstacle["position"][2]) + 0.5 * float(obstacle["size"][2])  # the block's top, base z [m]
+    # Down to the top at the approach speed, four times over, then the press, settle and slide with margin.
+    deadline = sim.time + 4.0 * (float(sim.eef_pose()[0][2]) - top) / _APPROACH + 30.0
     while sim.time < deadline:
         force = force_z() - weight
         filtered += (force - filtered) * _LOW_PASS
@@ -105,7 +109,7 @@ def servo_scale(
     with the slide at the effort rule's gains and at the scale taken. (1.0, ...) when clean as given or when
     no scale is (the package keeps its gains; the caller says so)."""
     first = slide_force_std(urdf_xml, scene, joints, direction)
-    if first.clean or first.std != first.std:
+    if first.clean or math.isnan(first.std):
         return 1.0, first, first
     least = min(scene["servo"]["kp"].values())
     for scale in SCALES[1:]:

@@ -263,8 +263,7 @@ def _surface(scenario: Scenario, rec: Recording) -> Verdict:
     ended_by_travel = rec.end_conditions.get("x") == 2
     known = rec.pose_t.size and rec.follow_up_time is not None
     travel_x = float(abs(_at(rec, end)[0] - _at(rec, start)[0])) if known else 0.0
-    touching = _window(rec.wrench_t, -np.inf, start) if rec.wrench_t.size else slice(0)
-    peak = _max(rec.contact_force[touching, 2]) if rec.wrench_t.size else nan
+    peak = _max(rec.contact_force[_window(rec.wrench_t, -np.inf, start), 2]) if rec.wrench_t.size else nan
     peak_all = _max(rec.contact_force[:, 2]) if rec.wrench_t.size else nan
     figures = {
         "target contact force [N]": target,
