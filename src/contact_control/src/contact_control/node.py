@@ -19,7 +19,9 @@ from compliant_common.ros_time import JumpAwareClock
 from compliant_common.runtime import tune_runtime
 from compliant_common.ticker import start_ticker
 from geometry_msgs.msg import WrenchStamped
+from sensor_msgs.msg import JointState
 
+from contact_control.bias_map import BiasMapError
 from contact_control.params import PARAMETERS, ContactControlSettings
 from contact_control.ros_io import ContactControlRos, TfPoses, fill_status_words, read_settings
 from contact_control.stage import ContactStage, describe_laws
@@ -41,6 +43,9 @@ class ContactControlNode:
         self.ros = ContactControlRos(self.stage, self._lock)
         self._sub = rospy.Subscriber(s.ft_in_topic, WrenchStamped, self._on_wrench, queue_size=1,
                                      tcp_nodelay=True)
+        if self.stage.bias_map is not None:  # its offset follows the joints
+            self._joints_sub = rospy.Subscriber(s.bias_map_joint_states, JointState, self._on_joint_state,
+                                                queue_size=1, tcp_nodelay=True)
         start_ticker(self._tick, 1.0 / s.control_rate, "contact_control_ticks")
         rospy.on_shutdown(self.ros.shutdown)
 
@@ -59,6 +64,10 @@ class ContactControlNode:
             self.stage.update_contact()  # after the twist: off its path
             self.ros.send_contact()
             self.ros.after()
+
+    def _on_joint_state(self, msg: JointState) -> None:
+        with self._lock:
+            self.stage.on_joint_state(msg.name, msg.position)
 
     def _tick(self) -> float:
         t, jump = self._clock.read()
@@ -81,7 +90,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     settings = read_settings()
     if settings is None:
         return 1
-    node = ContactControlNode(settings)
+    try:
+        node = ContactControlNode(settings)
+    except BiasMapError as err:
+        rospy.logfatal("contact_control_node: not starting: %s", err)
+        return 1
     MasterWatch(node.ros.master_lost, node.ros.master_back, params=["~"])
     tune_runtime(1.0 / settings.control_rate)
     rospy.loginfo(

@@ -131,6 +131,14 @@ class ContactControlSettings:
         (0.0,) * 6, type="floats", length=6, unit="N, Nm",
         doc="known sensor offset (sensor frame) subtracted until the first tare",
     )
+    bias_map: str = param(
+        "", doc="path of a bias map file (`calibrate_bias`, README *Bias map*): the sensor's offset as a "
+        "function of the joint positions, subtracted every cycle; empty: none"
+    )
+    bias_map_joint_states: str = param(
+        "joint_states", doc="sensor_msgs/JointState input of contact_control_node when `bias_map` is set "
+        "(control_stack_node uses jog_arm's)"
+    )
     tare_min_samples: float = _nonneg(
         25.0, "", "start-up zeroing also waits for this many samples (0.83 s of a 30 Hz sensor): the noise "
         "floor (std per axis) is measured over the same window"

@@ -55,9 +55,12 @@ class WrenchPreprocessor:
         self._signs = settings.ft_directions
         self._flip = self._signs != (1, 1, 1)
         self._bias = [float(b) for b in settings.bias]
-        self._mass = settings.tool_mass
-        self._mg = [settings.tool_mass * g for g in settings.gravity]
-        self._com = tuple(settings.tool_com)
+        # The pose-dependent offset a bias map predicts (set_pose_bias); `_offset` = bias + it, per cycle.
+        self._pose_bias = [0.0] * 6
+        self._offset = list(self._bias)
+        self._tool = (settings.tool_mass, tuple(settings.tool_com))
+        self._gravity = tuple(settings.gravity)
+        self.set_load_error(0.0, (0.0, 0.0, 0.0))
         self.set_limits(settings.global_max_force, settings.global_max_torque)
         self.set_deadband(settings.force_deadband, settings.torque_deadband)
         self._filter: LowPass | None = None
@@ -83,8 +86,36 @@ class WrenchPreprocessor:
         if len(bias) != 6 or not is_finite6(bias):
             raise PreprocessError(f"bias must be 6 finite numbers, got {bias!r}")
         self._bias = [float(b) for b in bias]
+        self._offset = [b + p for b, p in zip(self._bias, self._pose_bias, strict=True)]
         if self._filter:
             self._filter.reset([0.0] * 6 if at_rest else None)
+
+    def set_load_error(self, mass: float, moment: Sequence[float]) -> None:
+        """A load the sensor carries beyond the configured tool: mass [kg] (may be negative) and first
+        moment (mass times centre of mass) [kg m] in the sensor frame (a bias map's load part)."""
+        tool_mass, com = self._tool
+        self._mass = tool_mass + mass
+        self._moment = tuple(tool_mass * c + h for c, h in zip(com, moment, strict=True))
+        self._mg = [self._mass * g for g in self._gravity]
+        self._weighs = bool(self._mass) or any(self._moment)
+
+    @property
+    def weighs(self) -> bool:
+        """Whether a load is compensated (then every wrench needs the sensor's orientation)."""
+        return self._weighs
+
+    @property
+    def pose_bias(self) -> tuple[float, ...]:
+        """The pose-dependent offset subtracted now (a bias map's residual at the current joints)."""
+        return tuple(self._pose_bias)
+
+    def set_pose_bias(self, values: Sequence[float]) -> None:
+        """The pose-dependent offset at the current joint positions [N, Nm], sensor frame after sign flips:
+        subtracted from every wrench beside the bias, and left out of what `tare` stores."""
+        p, o, b = self._pose_bias, self._offset, self._bias
+        for i in range(6):
+            p[i] = values[i]
+            o[i] = b[i] + p[i]
 
     def set_limits(self, max_force: float, max_torque: float) -> None:
         """Global limits on |force| [N] and |torque| [Nm] of the compensated sensor wrench."""
@@ -139,18 +170,19 @@ class WrenchPreprocessor:
     # --- tool gravity and tare ---
     def gravity_wrench(self, R_world_sensor: Matrix | None) -> list[float]:
         """The tool's weight as the sensor reads it at this orientation (sensor frame, about its origin)."""
-        if not self._mass:
+        if not self._weighs:
             return [0.0] * 6
         if R_world_sensor is None:
-            raise PreprocessError("tool_mass is set, so the sensor orientation R_world_sensor is needed")
+            raise PreprocessError("a tool mass is set, so the sensor orientation R_world_sensor is needed")
         r = as_rows(R_world_sensor)
-        gx, gy, gz = self._mg
-        # R^T (m g): gravity expressed in the sensor frame.
-        fx = r[0][0] * gx + r[1][0] * gy + r[2][0] * gz
-        fy = r[0][1] * gx + r[1][1] * gy + r[2][1] * gz
-        fz = r[0][2] * gx + r[1][2] * gy + r[2][2] * gz
-        cx, cy, cz = self._com
-        return [fx, fy, fz, cy * fz - cz * fy, cz * fx - cx * fz, cx * fy - cy * fx]
+        gx, gy, gz = self._gravity
+        # u = R^T g: gravity in the sensor frame; the load's wrench is (m u, h x u).
+        ux = r[0][0] * gx + r[1][0] * gy + r[2][0] * gz
+        uy = r[0][1] * gx + r[1][1] * gy + r[2][1] * gz
+        uz = r[0][2] * gx + r[1][2] * gy + r[2][2] * gz
+        m = self._mass
+        hx, hy, hz = self._moment
+        return [m * ux, m * uy, m * uz, hy * uz - hz * uy, hz * ux - hx * uz, hx * uy - hy * ux]
 
     def oriented(self, raw: Sequence[float]) -> list[float]:
         """The raw wrench with the configured sign flips (what `gravity_wrench` + bias model), a new list."""
@@ -174,6 +206,7 @@ class WrenchPreprocessor:
             PreprocessError: the reading is not finite or the orientation is missing while tool_mass > 0.
         """
         self._bias = self.bias_estimate(raw, R_world_sensor)
+        self._offset = [b + p for b, p in zip(self._bias, self._pose_bias, strict=True)]
         if self._filter:
             self._filter.reset()
         return tuple(self._bias)
@@ -188,7 +221,8 @@ class WrenchPreprocessor:
             raise PreprocessError(f"cannot tare with an invalid wrench {raw!r}")
         expected = self.gravity_wrench(R_world_sensor)
         w = self._flipped(raw)
-        return [w[i] - expected[i] for i in range(6)]
+        p = self._pose_bias
+        return [w[i] - expected[i] - p[i] for i in range(6)]
 
     def contact_force(
         self, raw: Sequence[float], R_world_sensor: Matrix | None = None
@@ -203,9 +237,9 @@ class WrenchPreprocessor:
         if self._flip:
             sx, sy, sz = self._signs
             fx, fy, fz = fx * sx, fy * sy, fz * sz
-        b = self._bias
+        b = self._offset
         fx, fy, fz = float(fx) - b[0], float(fy) - b[1], float(fz) - b[2]
-        if self._mass:
+        if self._weighs:
             if R_world_sensor is None:
                 return None
             r = as_rows(R_world_sensor)
@@ -241,9 +275,9 @@ class WrenchPreprocessor:
         if self._flip:
             sx, sy, sz = self._signs
             fx, fy, fz, tx, ty, tz = fx * sx, fy * sy, fz * sz, tx * sx, ty * sy, tz * sz
-        b = self._bias
+        b = self._offset
         fx, fy, fz, tx, ty, tz = fx - b[0], fy - b[1], fz - b[2], tx - b[3], ty - b[4], tz - b[5]
-        if self._mass:
+        if self._weighs:
             g = self.gravity_wrench(R_world_sensor)
             fx, fy, fz, tx, ty, tz = fx - g[0], fy - g[1], fz - g[2], tx - g[3], ty - g[4], tz - g[5]
         if fx * fx + fy * fy + fz * fz > self._fmax2 or tx * tx + ty * ty + tz * tz > self._tmax2:

@@ -24,6 +24,7 @@ from contact_control.axes import (
     LAW_PATH,
     SAFETY_NO_TF,
 )
+from contact_control.bias_map import BiasMap, BiasMapError, ResidualPredictor, load_bias_map
 from contact_control.controller import ContactControl, CycleResult
 from contact_control.events import ContactEvent, EventWatch
 from contact_control.frames import IDENTITY, Rows, compose, inverse, rotate_twist, rotation, transpose_times
@@ -82,7 +83,15 @@ class ContactStage:
         self.limits = RequestLimits.from_settings(settings)
         self._poses = poses
         self._monotonic = monotonic
-        self._gravity = s.tool_mass > 0.0
+        #: The sensor's offset by pose (`bias_map`), None without one; the load part is compensated like
+        #: the tool, the residual follows `on_joint_state`.
+        self.bias_map = _bias_map(s)
+        if self.bias_map is not None:
+            self.ctrl.preprocessor.set_load_error(self.bias_map.mass, self.bias_map.moment)
+        self._predict: ResidualPredictor | None = None
+        self._joint_names: Sequence[str] = ()
+        self._joints_missing = "no joint state yet" if self.bias_map is not None else ""
+        self._gravity = self.ctrl.preprocessor.weighs
         #: The frames a cycle may look up besides the fixed one.
         self.frames_used = frozenset(
             {s.control_frame, s.ft_sensor_frame, s.eef_frame, s.velocity_command_frame} - {s.fixed_frame}
@@ -162,6 +171,23 @@ class ContactStage:
         return [row[:3] for row in self._pose(self.settings.ft_sensor_frame)[:3]]
 
     # --- data ---
+    def on_joint_state(self, names: Sequence[str], positions: Sequence[float]) -> None:
+        """Joint positions [rad] (the bias map's residual follows them); nothing without a map."""
+        if self.bias_map is None:
+            return
+        predict = self._predict
+        if predict is None or (names is not self._joint_names and tuple(names) != predict.names):
+            try:
+                predict = self._predict = self.bias_map.predictor(names)
+            except BiasMapError as err:
+                if str(err) != self._joints_missing:
+                    self.notes.append(("error", f"{err}: holding (zero twist)"))
+                    self._joints_missing = str(err)
+                return
+        self._joint_names = names
+        self.ctrl.preprocessor.set_pose_bias(predict(positions))
+        self._joints_missing = ""
+
     def on_wrench(
         self, wrench: Sequence[float], frame: str, stamp: float | None, t: float
     ) -> Velocity | None:
@@ -171,6 +197,8 @@ class ContactStage:
         sensor_frame = ("" if s.use_ft_sensor_frame else frame) or s.ft_sensor_frame
         self._have_frames = False
         try:
+            if self._joints_missing:
+                raise LookupError(f"the bias map's joints: {self._joints_missing}")
             T_cs, R_ws, eef, R_fc, R_cc = self._frames(sensor_frame)
         except LookupError as err:
             why = f"no transform: {err}"
@@ -374,6 +402,21 @@ class ContactStage:
         if fault and over and not fault.startswith("ROS master"):  # the jump is over
             self._fault_note = fault = ""
         return r, "; ".join(m for m in (fault, r.message, self._request_note) if m)
+
+
+def _bias_map(settings: ContactControlSettings) -> BiasMap | None:
+    """The settings' bias map, None without one.
+
+    Raises:
+        BiasMapError: The file cannot be used, or it holds for another frame than `ft_sensor_frame`.
+    """
+    if not settings.bias_map:
+        return None
+    loaded = load_bias_map(settings.bias_map)
+    if loaded.frame and loaded.frame != settings.ft_sensor_frame:
+        raise BiasMapError(f"bias_map {settings.bias_map}: fitted for the wrench in {loaded.frame!r}, but "
+                           f"ft_sensor_frame is {settings.ft_sensor_frame!r}")
+    return loaded
 
 
 def describe_laws(move_id: int, laws: Sequence[AxisLaw]) -> str:

@@ -18,6 +18,7 @@ import rospy
 from compliant_common.master import MasterWatch
 from compliant_common.runtime import tune_runtime
 from compliant_common.ticker import start_ticker
+from contact_control.bias_map import BiasMapError
 from contact_control.ros_io import ContactControlRos, TfPoses, read_settings
 from contact_control.stage import Velocity
 from geometry_msgs.msg import TwistStamped, WrenchStamped
@@ -134,6 +135,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         pipeline = CompliantPipeline(settings, jog[0], jog[1], tf)
     except (SettingsError, KinematicsError) as err:
         rospy.logfatal(f"jog_arm_server refused to start: {err}")
+        return 1
+    except BiasMapError as err:
+        rospy.logfatal(f"contact_control refused to start: {err}")
         return 1
     node = ControlStackNode(pipeline, tf, cc_ns, jog_ns)
     MasterWatch(node.master_lost, node.master_back, params=[cc_ns, jog_ns, "robot_description"])

@@ -115,6 +115,7 @@ class CompliantPipeline:
     def on_joint_state(self, names: Sequence[str], positions: Sequence[float], t: float) -> PipelineOutput:
         """A joint state received at `t` [s]."""
         out = self._check_clock(t)
+        self.contact.on_joint_state(names, positions)  # the bias map's offset at these joints (if any)
         if self.jog.on_joint_state(names, positions, t):
             # The poses the next wrench needs, computed now (the joint state leads the wrench by half a
             # period in the simulation; the jog stage prepares its Jacobian likewise).
