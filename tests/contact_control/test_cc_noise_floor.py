@@ -234,3 +234,18 @@ def test_the_drift_of_a_noisy_estimate_is_measured_within_its_noise():
     watch.noise = tuple(CURRENT_ESTIMATE)
     watch.restart()
     assert any(watch.add(w, bias, k / 50) is not None for k, w in enumerate(samples))
+
+
+def test_the_offset_moving_with_the_pose_raises_the_smallest_limit_and_says_so(tmp_path):
+    """A declared pose-dependent offset (no map) or a bias map's held-out residual counts beside the noise:
+    a limit the noise alone would allow is refused over the move, with that reason."""
+    plain, *_ = zeroed()
+    noise_only, _ = plain.resolvable()
+    ctrl, *_ = zeroed(pose_offset_force=0.3)
+    force, _ = ctrl.resolvable()
+    assert force == pytest.approx(np.hypot(noise_only, 5 * 0.3), rel=1e-6)  # 5 sigmas: ~1.57 N
+    plain.set_laws(laws(z=AxisLaw(LAW_COMPLIANT_MOVE, velocity=-0.01, force_limit=1.0)), np.eye(4), 1.0)
+    with pytest.raises(RequestError) as err:
+        ctrl.set_laws(laws(z=AxisLaw(LAW_COMPLIANT_MOVE, velocity=-0.01, force_limit=1.0)), np.eye(4), 1.0)
+    message = err.value.message
+    assert "offset's change with the pose 0.3 N" in message and f"{force:.3g} N" in message

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from contact_control.axes import LAW_COMPLIANT_MOVE, LAW_SPRING
-from contact_control.bias_map import MapSample, fit_bias_map
+from contact_control.bias_map import BiasMapError, MapSample, fit_bias_map, load_bias_map
 from contact_control.laws import AxisLaw
 from control_stack.calibration import Box, CalibrationError, plan_sweep
 from harness.pipeline_cell import Cell
@@ -55,7 +55,7 @@ def calibrate(cell: Cell, path) -> str:
     """The sweep a user runs (`calibrate_bias`), done on the model: each pose's rest wrench, fitted."""
     arm = cell.pipeline.jog.jog.model
     order = [cell.names.index(n) for n in arm.joint_names]
-    poses = plan_sweep(arm, cell.q[order], Box((-0.32, 0.05), (-0.05, 0.05), (-0.03, 0.08)), count=40)
+    poses = plan_sweep(arm, cell.q[order], Box((-0.32, 0.05), (-0.05, 0.05), (-0.03, 0.08)), count=60)
     samples = []
     noise = np.random.default_rng(2)
     for q_model in poses:
@@ -65,6 +65,7 @@ def calibrate(cell: Cell, path) -> str:
         rest = sensor_error(q, R) + noise.normal(0.0, 0.05, 6) * [1, 1, 1, 0.01, 0.01, 0.01]
         samples.append(MapSample(tuple(q), tuple(R.T @ G), tuple(rest)))
     fitted = fit_bias_map(cell.names, samples, frame=cell.cc.ft_sensor_frame)
+    print(fitted.describe())
     path.write_text(fitted.to_yaml())
     return str(path)
 
@@ -74,9 +75,23 @@ def test_the_offset_alone_stops_the_move_and_the_map_lets_it_run_its_travel(tmp_
     assert travel < 0.8 * TRAVEL, f"without the map it should stop early: {travel * 1e3:.1f} mm, {why}"
     assert "force" in why or "torque" in why, why
     path = calibrate(Cell("ur5"), tmp_path / "bias_map.yaml")
-    travel, why = run_hybrid(Cell("ur5", params={"bias_map": path}, sensor_error=sensor_error))
+    mapped = Cell("ur5", params={"bias_map": path}, sensor_error=sensor_error)
+    travel, why = run_hybrid(mapped)
     assert travel > TRAVEL - 0.002, f"with the map: {travel * 1e3:.1f} mm, {why}"
     assert "travel" in why or "deviation" in why, why
+    # What the map leaves counts in the smallest force limit the stack accepts.
+    fitted = load_bias_map(path)
+    assert mapped.pipeline.contact.ctrl.pose_residual == (fitted.residual_force, fitted.residual_torque)
+
+
+def test_a_map_of_another_frame_or_file_is_refused_before_anything_moves(tmp_path) -> None:
+    path = calibrate(Cell("ur5"), tmp_path / "bias_map.yaml")
+    other = tmp_path / "other.yaml"
+    other.write_text(open(path).read().replace("frame: ft_sensor", "frame: tool0_controller"))
+    with pytest.raises(BiasMapError, match="ft_sensor_frame is 'ft_sensor'"):
+        Cell("ur5", params={"bias_map": str(other)})
+    with pytest.raises(BiasMapError, match="No such file"):
+        Cell("ur5", params={"bias_map": str(tmp_path / "none.yaml")})
 
 
 def test_a_sweep_the_arm_cannot_reach_is_refused_with_the_reason() -> None:

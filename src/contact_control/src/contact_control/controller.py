@@ -245,6 +245,9 @@ class ContactControl:
         self._tare_pending = s.tare_on_startup
         self._zeroing = self._new_zeroing() if s.tare_on_startup else None
         self._floor_noise: NoiseFloor | None = None
+        #: How far the offset moves over the workspace beyond the noise (force [N], torque [Nm]): a bias
+        #: map's held-out residual, else the declared pose_offset_force / _torque.
+        self.pose_residual = (s.pose_offset_force, s.pose_offset_torque)
         self._gain_bound = GainBound(s.loop_gain_delay, s.command_latency, s.spring_output_scale,
                                      s.contact_stiffness)
         self._limit_samples = int(s.force_limit_samples)
@@ -315,7 +318,9 @@ class ContactControl:
         sigmas = self.settings.noise_limit_sigmas
         if self._floor_noise is None or sigmas <= 0.0:
             return 0.0, 0.0
-        return self._floor_noise.resolvable(sigmas)
+        force, torque = self._floor_noise.resolvable(sigmas)
+        pose_force, pose_torque = self.pose_residual
+        return math.hypot(force, sigmas * pose_force), math.hypot(torque, sigmas * pose_torque)
 
     def bound_gains(self, laws: Sequence[AxisLaw]) -> tuple[list[AxisLaw], list[str]]:
         """The laws with their loop gains within what the sensor's measured rate (`lp_filter_delta_t` until
@@ -339,12 +344,15 @@ class ContactControl:
             if law.law and 0.0 < law.force_limit < least:
                 unit, what = ("Nm", "torque") if i >= 3 else ("N", "force")
                 std = floor.torque if i >= 3 else floor.force
+                pose = self.pose_residual[1 if i >= 3 else 0]
+                moving = (f" and the offset's change with the pose {pose:.3g} {unit} (the bias map's "
+                          "held-out residual, or pose_offset_force / _torque)") if pose > 0.0 else ""
                 raise RequestError(
                     SET_CONTROL_FORCE_FAILED,
                     f"axis {AXES[i]}: {what} limit {law.force_limit:g} {unit} is below what the sensor "
                     f"resolves, {least:.3g} {unit} ({self.settings.noise_limit_sigmas:g} x its filtered "
-                    f"noise {std:.3g} {unit}, measured at rest while zeroing; noise_limit_sigmas): set a "
-                    f"limit of at least {least:.3g} {unit}",
+                    f"noise {std:.3g} {unit}, measured at rest while zeroing{moving}; noise_limit_sigmas): "
+                    f"set a limit of at least {least:.3g} {unit}",
                     AXES[i],
                 )
 

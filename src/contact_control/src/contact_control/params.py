@@ -139,6 +139,12 @@ class ContactControlSettings:
         "joint_states", doc="sensor_msgs/JointState input of contact_control_node when `bias_map` is set "
         "(control_stack_node uses jog_arm's)"
     )
+    pose_offset_force: float = _nonneg(
+        0.0, "N", "how far the sensor's offset moves over the workspace without a `bias_map` (a driver's "
+        "documented pose-dependent error): force limits below `noise_limit_sigmas` of it and the noise are "
+        "refused; with a map its held-out residual counts instead; 0: unknown"
+    )
+    pose_offset_torque: float = _nonneg(0.0, "Nm", "same for torques")
     tare_min_samples: float = _nonneg(
         25.0, "", "start-up zeroing also waits for this many samples (0.83 s of a 30 Hz sensor): the noise "
         "floor (std per axis) is measured over the same window"

@@ -88,6 +88,7 @@ class ContactStage:
         self.bias_map = _bias_map(s)
         if self.bias_map is not None:
             self.ctrl.preprocessor.set_load_error(self.bias_map.mass, self.bias_map.moment)
+            self.ctrl.pose_residual = (self.bias_map.residual_force, self.bias_map.residual_torque)
         self._predict: ResidualPredictor | None = None
         self._joint_names: Sequence[str] = ()
         self._joints_missing = "no joint state yet" if self.bias_map is not None else ""

@@ -92,6 +92,7 @@ def _launch_file(
   <arg name="single_process" default="true" doc="contact_control and jog_arm in one process (control_stack_node), as sim.launch; false: two nodes, the twist over a topic"/>
   <arg name="with_named_poses" default="true" doc="start named_poses (move_to a pose of config/named_poses.yaml)"/>
   <arg name="viewer" default="false" doc="rviz: RViz on config/view.rviz with the stack's markers (needs a DISPLAY)"/>
+  <arg name="bias_map" default="" doc="bias map file of this robot's wrench (control_stack calibrate_bias, contact_control README: Bias map): its pose-dependent offset is subtracted; empty: none"/>
   <arg name="output" default="screen" doc="screen or log"/>
 {remap}
   <include file="$(find control_stack)/launch/inc/control_stack.launch.xml">
@@ -103,6 +104,7 @@ def _launch_file(
     <arg name="with_jog_arm" value="$(arg with_jog_arm)"/>
     <arg name="with_contact_control" value="$(arg with_contact_control)"/>
     <arg name="single_process" value="$(arg single_process)"/>
+    <arg name="bias_map" value="$(arg bias_map)"/>
     <arg name="output" value="$(arg output)"/>
   </include>
 {named_poses_comment}
