@@ -14,7 +14,7 @@ import numpy as np
 from mujoco_driver.controllers import ControllerManager, SwitchResult
 from mujoco_driver.profiles import DriverProfile, ProfileError
 from mujoco_driver.sim import Simulation
-from mujoco_driver.wrench_models import Reflex, WrenchModel, change_frame, gravity_wrench
+from mujoco_driver.wrench_models import Reflex, WrenchModel, change_frame, gravity_wrench, set_payload_weight
 
 __all__ = ["DriverEmulation"]
 
@@ -43,6 +43,10 @@ class DriverEmulation:
         self.model = WrenchModel(profile.wrench, len(sim.joint_names), 1.0 / profile.publish_rate)
         self.reflex = Reflex(profile.reflex.force_thresholds) if profile.reflex else None
         self.wrench = np.zeros(6)  # what the driver publishes [N, Nm]
+        spec = profile.wrench
+        self._payload_error = spec.payload_mass_error != 0.0 or any(spec.payload_com_error)
+        # The wrench frame's Jacobian (world axes, all dofs), computed only for a torque model error.
+        self._jac = (np.zeros((3, model.nv)), np.zeros((3, model.nv))) if spec.torque_error else None
         # Per tf entry: translation [m] and quaternion (x, y, z, w) of child in parent.
         self.transforms = [(np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0])) for _ in profile.tf]
         self._quat = np.zeros(4)
@@ -50,6 +54,15 @@ class DriverEmulation:
     def _pose(self, link: str) -> tuple[np.ndarray, np.ndarray]:
         data, body = self.sim.data, self._body[link]
         return data.xmat[body].reshape(3, 3), data.xpos[body]
+
+    def _jacobian(self, r_f: np.ndarray) -> np.ndarray | None:
+        """The wrench frame's Jacobian (6 x joints: linear rows of its origin, in its axes), if needed."""
+        if self._jac is None:
+            return None
+        (jacp, jacr), sim = self._jac, self.sim
+        mujoco.mj_jacBody(sim.model, sim.data, jacp, jacr, self._body[self.profile.wrench.frame_link])
+        dofs = sim.scene.dof_adr
+        return np.vstack([r_f.T @ jacp[:, dofs], r_f.T @ jacr[:, dofs]])
 
     def update(self, sensor: np.ndarray) -> bool:
         """Compute the published wrench and transforms from the current state.
@@ -65,9 +78,13 @@ class DriverEmulation:
         p_s = data.site_xpos[scene.ft_site]
         r_f, p_f = self._pose(self.profile.wrench.frame_link)
         in_frame = change_frame(sensor, r_s, p_s, r_f, p_f)
-        mass = sim.model.body_subtreemass[scene.sensor_body]
-        weight = gravity_wrench(mass, data.subtree_com[scene.sensor_body], p_f, r_f, sim.model.opt.gravity)
-        self.wrench[:] = self.model(in_frame, weight, sim.qpos)
+        mass, com = sim.model.body_subtreemass[scene.sensor_body], data.subtree_com[scene.sensor_body]
+        gravity = sim.model.opt.gravity
+        weight = gravity_wrench(mass, com, p_f, r_f, gravity)
+        payload = None
+        if self._payload_error:
+            payload = set_payload_weight(self.profile.wrench, mass, com, p_f, r_f, gravity)
+        self.wrench[:] = self.model(in_frame, weight, sim.qpos, self._jacobian(r_f), payload)
         for (pos, quat), spec in zip(self.transforms, self.profile.tf, strict=True):
             r_p, p_p = self._pose(spec.parent_link)
             r_c, p_c = self._pose(spec.child_link)

@@ -37,6 +37,8 @@ __all__ = ["DriverProfile", "FrameLink", "ProfileError", "ReflexSpec", "WrenchSp
 PROFILE_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
                            "config", "profiles")
 _MODELS = ("sensor", "payload_compensated", "external_estimate", "current_estimate")
+_WEIGHT_REMOVED = _MODELS[1:]  # the models that subtract a payload's weight
+_FROM_JOINT_TORQUES = ("external_estimate", "current_estimate")
 
 
 class ProfileError(StackError):
@@ -58,7 +60,15 @@ class WrenchSpec:
         sign: +1: the wrench the environment exerts on the tool; -1: its opposite (the wrench the robot
             exerts on the environment).
         offset_force, offset_torque: Amplitude of the configuration-dependent offset [N, Nm].
-        offset_scale: Joint-space frequency of the offset [1/rad]: how fast it changes with the configuration.
+        offset_scale: Joint-space frequency of the offset [1/rad]: how fast it changes with the configuration
+            (also that of ``torque_error``).
+        payload_mass_error: The payload mass set on the robot minus the true tool's [kg]: the driver removes
+            the set payload's weight, so the published wrench carries minus the difference's weight (+0.3 kg:
+            +2.9 N against gravity, turning with the tool). Models that remove a weight only.
+        payload_com_error: The set payload's centre of mass minus the true tool's, in the wrench frame [m].
+        torque_error: Amplitude per joint of a joint-torque model error [Nm] that changes smoothly with the
+            configuration; an estimate from joint torques turns it into a wrench error through the wrench
+            frame's Jacobian. ``external_estimate`` and ``current_estimate`` only.
         noise_force, noise_torque: Standard deviation of the white noise [N, Nm], one for all three axes or
             one per axis.
         drift_force, drift_torque: Stationary standard deviation of the slow drift (AR(1)) [N, Nm], idem.
@@ -78,6 +88,9 @@ class WrenchSpec:
     offset_force: float = 0.0
     offset_torque: float = 0.0
     offset_scale: float = 0.5
+    payload_mass_error: float = 0.0
+    payload_com_error: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    torque_error: float = 0.0
     noise_force: float | tuple[float, ...] = 0.0
     noise_torque: float | tuple[float, ...] = 0.0
     drift_force: float | tuple[float, ...] = 0.0
@@ -206,6 +219,22 @@ def _number(data: Mapping[str, Any], key: str, where: str, default: float | None
     return float(value)
 
 
+def _signed(value: Any, where: str) -> float:
+    """A finite number of either sign."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise ProfileError(f"{where}: expected a finite number, got {value!r}")
+    return float(value)
+
+
+def _vector3(data: Mapping[str, Any], key: str, where: str) -> tuple[float, float, float]:
+    """Three finite numbers [x, y, z] of either sign (default zeros)."""
+    value = data.get(key, [0.0, 0.0, 0.0])
+    if not isinstance(value, list | tuple) or len(value) != 3:
+        raise ProfileError(f"{where}.{key}: expected three numbers [x, y, z], got {value!r}")
+    x, y, z = (_signed(v, f"{where}.{key}") for v in value)
+    return x, y, z
+
+
 def _per_axis(data: Mapping[str, Any], key: str, where: str) -> float | tuple[float, ...]:
     """A number >= 0 for three axes, or a list of three."""
     value = data.get(key, 0.0)
@@ -266,6 +295,20 @@ def variant_options(name_or_path: str) -> list[dict[str, Any]]:
     return out or [{}]
 
 
+def _check_model_errors(wrench: WrenchSpec, where: str) -> None:
+    """Refuse an error the model cannot have (a raw sensor removes no payload; only an estimate from joint
+    torques has a joint-torque model error)."""
+    payload = {"payload_mass_error": wrench.payload_mass_error != 0.0,
+               "payload_com_error": any(wrench.payload_com_error)}
+    for key, nonzero in payload.items():
+        if nonzero and wrench.model not in _WEIGHT_REMOVED:
+            raise ProfileError(f"{where}.{key}: only for a model that removes the payload's weight "
+                               f"{_WEIGHT_REMOVED}, not {wrench.model!r} (a raw sensor reads the true tool)")
+    if wrench.torque_error and wrench.model not in _FROM_JOINT_TORQUES:
+        raise ProfileError(f"{where}.torque_error: only for a wrench estimated from joint torques "
+                           f"{_FROM_JOINT_TORQUES}, not {wrench.model!r}")
+
+
 def load_profile(name_or_path: str, options: Mapping[str, Any] | None = None) -> DriverProfile:
     """Read, resolve and validate a profile.
 
@@ -323,6 +366,9 @@ def load_profile(name_or_path: str, options: Mapping[str, Any] | None = None) ->
         offset_force=_number(w, "offset_force", f"{where}.wrench", 0.0),
         offset_torque=_number(w, "offset_torque", f"{where}.wrench", 0.0),
         offset_scale=_number(w, "offset_scale", f"{where}.wrench", 0.5),
+        payload_mass_error=_signed(w.get("payload_mass_error", 0.0), f"{where}.wrench.payload_mass_error"),
+        payload_com_error=_vector3(w, "payload_com_error", f"{where}.wrench"),
+        torque_error=_number(w, "torque_error", f"{where}.wrench", 0.0),
         noise_force=_per_axis(w, "noise_force", f"{where}.wrench"),
         noise_torque=_per_axis(w, "noise_torque", f"{where}.wrench"),
         drift_force=_per_axis(w, "drift_force", f"{where}.wrench"),
@@ -334,6 +380,7 @@ def load_profile(name_or_path: str, options: Mapping[str, Any] | None = None) ->
         seed=int(_number(w, "seed", f"{where}.wrench", 0)),
         zero_service=_string(w, "zero_service", f"{where}.wrench", ""),
     )
+    _check_model_errors(wrench, f"{where}.wrench")
     tf = []
     for i, entry in enumerate(data.get("tf") or []):
         at = f"{where}.tf[{i}]"

@@ -4,18 +4,23 @@ The simulation's sensor reads the wrench the environment exerts on the tool (gra
 the tool's inertial force) in the sensor frame. A driver reports something else:
 
 * ``sensor``: that reading, only moved into the driver's frame;
-* ``payload_compensated``: minus the tool's weight, as a controller that knows its payload (with the
-  payload set, its TCP wrench reads zero at rest in any orientation);
+* ``payload_compensated``: minus the weight of the payload set on the robot, as a controller that knows
+  its payload (set right, its TCP wrench reads zero at rest in any orientation; set wrong,
+  ``payload_mass_error`` and ``payload_com_error``, the difference's weight remains, turning with the tool);
 * ``external_estimate``: a model-based estimate from joint torques (a torque-sensing arm's driver): net of
-  the configured load's weight;
+  the configured load's weight; an error of its joint-torque model (``torque_error``, smooth in the
+  configuration: friction, an averaged dynamic model) shows through the pseudo-inverse of the transposed
+  Jacobian;
 * ``current_estimate``: an estimate from joint motor currents (an arm without a wrist sensor, a UR CB3):
-  net of the payload, and low-pass filtered by the controller (``lag``).
+  net of the payload, and low-pass filtered by the controller (``lag``); like the above, a torque model
+  error may be set.
 
 Then the profile's sign: -1 reports the wrench the robot exerts on the environment (the profile YAML says
-which driver does that). Then the errors of a real sensor, each off unless the profile sets it
-(mujoco_driver's README, *Sensor errors*): white noise per axis, a slow drift (AR(1): stationary std
-``drift_*``, time constant ``drift_time_constant``), an offset that varies smoothly with the joint
-configuration (``offset_*``), and a shift of the zero after a heavy contact (``contact_shift_*``).
+which driver does that); the payload and torque model errors are part of the estimate and take it too.
+Then the errors of a real sensor, each off unless the profile sets it (mujoco_driver's README, *Sensor
+errors*): white noise per axis, a slow drift (AR(1): stationary std ``drift_*``, time constant
+``drift_time_constant``), an offset that varies smoothly with the joint configuration (``offset_*``), and a
+shift of the zero after a heavy contact (``contact_shift_*``).
 """
 
 from __future__ import annotations
@@ -26,9 +31,15 @@ import numpy as np
 
 from mujoco_driver.profiles import WrenchSpec
 
-__all__ = ["RateDivider", "Reflex", "WrenchModel", "change_frame", "gravity_wrench"]
+__all__ = ["RateDivider", "Reflex", "WrenchModel", "change_frame", "gravity_wrench", "set_payload_weight",
+           "wrench_from_joint_torques"]
 
 GRAVITY = np.array([0.0, 0.0, -9.81])
+# Damping of the least-squares inverse: none while the Jacobian's smallest singular value (mixed units: m
+# for the linear rows) is over SINGULAR_BAND, growing to DAMPING at a singularity: the gain stays under
+# 13 N per Nm. libfranka zeroes F_ext below 0.08 (libfranka #76); the robots' start poses are at 0.21.
+SINGULAR_BAND = 0.08
+DAMPING = 0.05
 
 
 def gravity_wrench(mass: float, com: np.ndarray, origin: np.ndarray, rotation: np.ndarray,
@@ -38,6 +49,30 @@ def gravity_wrench(mass: float, com: np.ndarray, origin: np.ndarray, rotation: n
     force = mass * gravity
     torque = np.cross(com - origin, force)
     return np.concatenate([rotation.T @ force, rotation.T @ torque])
+
+
+def set_payload_weight(spec: WrenchSpec, mass: float, com: np.ndarray, origin: np.ndarray,
+                       rotation: np.ndarray, gravity: np.ndarray = GRAVITY) -> np.ndarray:
+    """The weight of the payload set on the robot, which a compensating driver removes: the true tool's
+    ``mass`` and ``com`` (world) plus the spec's ``payload_mass_error`` and ``payload_com_error`` (the
+    latter in the frame ``rotation``); otherwise as :func:`gravity_wrench`."""
+    com_set = com + rotation @ np.asarray(spec.payload_com_error, dtype=float)
+    return gravity_wrench(mass + spec.payload_mass_error, com_set, origin, rotation, gravity)
+
+
+def wrench_from_joint_torques(jacobian: np.ndarray, torques: np.ndarray) -> np.ndarray:
+    """The wrench ``w`` that best explains joint torques ``torques = J^T w``: least squares (a 7-joint arm
+    has more torques than a wrench has components), damped near singularities (``SINGULAR_BAND``,
+    ``DAMPING``), as an estimator of the external wrench from joint torques does.
+
+    Args:
+        jacobian: 6 x n, the frame's (linear rows about its origin), in its axes.
+        torques: n joint torques [Nm].
+    """
+    u, s, vt = np.linalg.svd(jacobian, full_matrices=False)  # J = U S V^T: (J^T)^+ = U S^+ V^T
+    smallest = s[-1]
+    damping = DAMPING**2 * (1.0 - (smallest / SINGULAR_BAND) ** 2) if smallest < SINGULAR_BAND else 0.0
+    return np.asarray(u @ (s / (s * s + damping) * (vt @ torques)))
 
 
 def change_frame(wrench: np.ndarray, r_from: np.ndarray, p_from: np.ndarray, r_to: np.ndarray,
@@ -59,7 +94,7 @@ class WrenchModel:
 
     Args:
         spec: The profile's wrench section.
-        n_joints: Number of arm joints (the offset is a function of them).
+        n_joints: Number of joints (the offset and the torque error are functions of them).
         period: Time between two calls [s] (the drift and the lag advance by it).
     """
 
@@ -76,6 +111,13 @@ class WrenchModel:
         self._phases = self._rng.uniform(0.0, 2.0 * np.pi, 6)
         self._amplitude = np.array([spec.offset_force] * 3 + [spec.offset_torque] * 3)
         self._has_offset = bool(np.any(self._amplitude))
+        # Joint-torque model error: a sine per joint shaped like the offset, from its own random stream so
+        # that the streams above keep their numbers for a given seed.
+        torque_rng = np.random.default_rng(np.random.SeedSequence(spec.seed, spawn_key=(1,)))
+        directions = torque_rng.normal(size=(n_joints, n_joints))
+        directions *= spec.offset_scale / np.linalg.norm(directions, axis=1, keepdims=True)
+        self._torque_directions = directions
+        self._torque_phases = torque_rng.uniform(0.0, 2.0 * np.pi, n_joints)
         self._noise = np.concatenate([_triple(spec.noise_force), _triple(spec.noise_torque)])
         # AR(1) drift x' = a x + sqrt(1 - a^2) sigma w: stationary std sigma, correlation time tau.
         self._drift_std = np.concatenate([_triple(spec.drift_force), _triple(spec.drift_torque)])
@@ -106,6 +148,12 @@ class WrenchModel:
             return np.zeros(6)
         return self._amplitude * np.sin(self._directions @ q + self._phases)
 
+    def torque_error(self, q: np.ndarray) -> np.ndarray:
+        """The joint-torque model error at joint positions ``q`` [Nm]."""
+        if not self.spec.torque_error:
+            return np.zeros(len(self._torque_phases))
+        return self.spec.torque_error * np.sin(self._torque_directions @ q + self._torque_phases)
+
     def _contact(self, force: np.ndarray) -> None:
         """A heavy contact (over the threshold) leaves the zero shifted once it is released, by a fraction of
         its peak in a random direction (a recorded wrist sensor: ~9 N after a 116 N press)."""
@@ -119,13 +167,18 @@ class WrenchModel:
             self._shift[:3] += self.spec.contact_shift_fraction * self._peak * direction
             self._peak = 0.0
 
-    def __call__(self, sensor: np.ndarray, weight: np.ndarray, q: np.ndarray) -> np.ndarray:
+    def __call__(self, sensor: np.ndarray, weight: np.ndarray, q: np.ndarray,
+                 jacobian: np.ndarray | None = None, payload: np.ndarray | None = None) -> np.ndarray:
         """The published wrench.
 
         Args:
             sensor: The simulated sensor's reading, already in the driver's frame [N, Nm].
             weight: The tool's weight in the same frame (:func:`gravity_wrench`) [N, Nm].
-            q: Arm joint positions [rad].
+            q: Joint positions [rad].
+            jacobian: The frame's Jacobian at ``q`` (see :func:`wrench_from_joint_torques`); needed only
+                with ``torque_error``.
+            payload: The weight of the payload set on the robot (:func:`set_payload_weight`), which the
+                model removes instead of ``weight``; None: set right.
 
         Returns:
             The wrench the driver publishes (after :meth:`zero`'s bias).
@@ -133,9 +186,15 @@ class WrenchModel:
         value = self._value
         value[:] = sensor
         if self.spec.model != "sensor":
-            value -= weight
+            value -= weight if payload is None else payload
         if self.spec.contact_shift_threshold > 0.0:
-            self._contact(value[:3] if self.spec.model != "sensor" else value[:3] - weight[:3])
+            self._contact(sensor[:3] - weight[:3])
+        if self.spec.torque_error:
+            # tau_err is read as joint torques of a wrench on the tool (tau = J^T w): part of the estimate
+            # of the wrench on the robot, so it takes the sign below with the rest of it.
+            if jacobian is None:
+                raise ValueError("torque_error needs the wrench frame's Jacobian")
+            value += wrench_from_joint_torques(jacobian, self.torque_error(q))
         value *= self.spec.sign
         if self._lag < 1.0:  # the controller's filter on a current-based estimate
             if self._lagged is None:
