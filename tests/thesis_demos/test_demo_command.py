@@ -1,6 +1,6 @@
 """`make demo ROBOT=ur5 DRIVER=ur_robot_driver BAG=1` as a user runs it (scripts/demo): the simulated UR5
-speaking as ur_robot_driver (125 Hz), ur5_custom's hardware.launch on top, the demonstrations read the
-driver's wrench; the run is recorded into demo.bag."""
+speaking as ur_robot_driver (125 Hz), calibrated first (no bias map yet), ur5_custom's hardware.launch on top
+with the map, the demonstrations read the driver's wrench; the run is recorded into demo.bag."""
 
 import pathlib
 import re
@@ -22,15 +22,19 @@ def _demo(*args: str) -> list[str]:
 def test_surface_following_through_the_emulated_ur_robot_driver_is_recorded(tmp_path):
     """Surface following against the 125 Hz driver holds 10 +- 1.5 N over the slide (it failed at 5.9-12.3 N
     while the simulated tool hopped on the block), and the bag holds the driver's wrench at its rate."""
+    bias_map = tmp_path / "bias_map.yaml"
     command = _demo("--robot", "ur5", "--driver", "ur_robot_driver", "--only", "surface_following", "--bag",
-                    "--output", str(tmp_path))
+                    "--output", str(tmp_path), "--bias-map", str(bias_map), "--calibration-poses", "12")
     for _ in range(ATTEMPTS):
-        run = subprocess.run(command, capture_output=True, text=True, timeout=240, check=False)
+        bias_map.unlink(missing_ok=True)
+        run = subprocess.run(command, capture_output=True, text=True, timeout=300, check=False)
         if run.returncode == 0:
             break
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
     assert "[demo] running the demonstrations: surface_following\n" in run.stdout
     assert "[PASS] surface_following" in run.stdout
+    assert f"no bias map for ur_robot_driver at {bias_map}: calibrating first" in run.stdout
+    assert bias_map.exists() and "held-out" in bias_map.read_text()
     assert "switched controllers: started joint_group_vel_controller" in run.stdout
     assert (tmp_path / "surface_following.png").exists() and (tmp_path / "report.md").exists()
     wrenches = [m for _, _, m in read_bag(tmp_path / "demo.bag", topics=["/wrench"])]

@@ -46,8 +46,9 @@ class ControlStackNode:
         if p.frames_from_outside():
             tf.listen()
         same_topic = rospy.resolve_name(cc.velocity_out_topic) == rospy.resolve_name(jog.cmd_in_topic)
-        self.contact_ros = ContactControlRos(p.contact, self._lock, cc_ns, self._emit, int(same_topic))
+        # jog_arm's side first: contact_control's services (a ~stop) publish through it as soon as they exist.
         self.jog_ros = JogArmRos(p.jog, self._lock, jog_ns)
+        self.contact_ros = ContactControlRos(p.contact, self._lock, cc_ns, self._emit, int(same_topic))
         fast = {"queue_size": 1, "tcp_nodelay": True}
         self._twist_sub = rospy.Subscriber(jog.cmd_in_topic, TwistStamped, self._on_twist, **fast)
         self._subs = [
