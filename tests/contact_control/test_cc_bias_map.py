@@ -110,3 +110,12 @@ def test_bad_input_is_refused_with_the_reason(tmp_path) -> None:
         load_bias_map(str(bad))
     with pytest.raises(BiasMapError, match="No such file"):
         load_bias_map(str(tmp_path / "none.yaml"))
+
+
+def test_the_maps_error_leaves_out_the_noise_of_the_held_out_readings() -> None:
+    """Readings with 0.3 N of noise each: what is left on held-out poses is mostly their noise, which the
+    noise floor counts already; the map's own error (what contact_control adds to its floor) is far less."""
+    rng = np.random.default_rng(8)
+    noisy = fit_bias_map(NAMES, [reading(q, 0.3, rng) for q in sweep(60)])
+    assert noisy.held_out_std[0] > 0.2
+    assert noisy.residual_force < 0.6 * min(noisy.held_out_std[:3]), noisy.describe()

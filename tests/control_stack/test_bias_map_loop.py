@@ -9,7 +9,7 @@ import pytest
 from contact_control.axes import LAW_COMPLIANT_MOVE, LAW_SPRING
 from contact_control.bias_map import BiasMapError, MapSample, fit_bias_map, load_bias_map
 from contact_control.laws import AxisLaw
-from control_stack.calibration import Box, CalibrationError, plan_sweep
+from control_stack.calibration import Box, CalibrationError, plan_sweep, read_poses
 from harness.pipeline_cell import Cell
 
 G = np.array([0.0, 0.0, -9.81])
@@ -101,3 +101,19 @@ def test_a_sweep_the_arm_cannot_reach_is_refused_with_the_reason() -> None:
         plan_sweep(arm, cell.q, Box((2.0, 3.0), (2.0, 3.0), (2.0, 3.0)), count=10)
     with pytest.raises(CalibrationError, match="lows first"):
         Box.parse("0.1,-0.1,0,0,0,0")
+
+
+def test_a_yaml_of_joint_poses_is_read_in_the_arms_order_and_checked(tmp_path) -> None:
+    names = ("a", "b")
+    good = tmp_path / "poses.yaml"
+    good.write_text("".join(f"- {{b: {k * 0.1}, a: {-k * 0.1}, gripper: 0.0}}\n" for k in range(10)))
+    poses = read_poses(str(good), names)
+    assert len(poses) == 10 and np.allclose(poses[3], [-0.3, 0.3])
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("- {a: 0.0}\n" * 10)
+    with pytest.raises(CalibrationError, match=r"pose 0 has no position for \['b'\]"):
+        read_poses(str(bad), names)
+    short = tmp_path / "short.yaml"
+    short.write_text("- {a: 0.0, b: 0.0}\n" * 3)
+    with pytest.raises(CalibrationError, match="10 or more"):
+        read_poses(str(short), names)

@@ -237,3 +237,8 @@ def test_the_options_reach_the_wrench_spec_and_default_to_none():
         assert spec.torque_error == 0.0
     with pytest.raises(ProfileError, match="unknown option 'torque_error'"):
         load_profile("ur_robot_driver", {"torque_error": 0.5})
+    # The UR's offset over the joints: off unless asked; the current estimate keeps its own 5 N.
+    assert load_profile("ur_robot_driver", {}).wrench.offset_force == 0.0
+    e_series = load_profile("ur_robot_driver", {"series": "e_series", "offset_force": 3.0}).wrench
+    assert e_series.offset_force == 3.0
+    assert load_profile("ur_robot_driver", {"series": "cb3_estimate"}).wrench.offset_force == 5.0

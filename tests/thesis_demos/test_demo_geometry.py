@@ -143,6 +143,11 @@ def test_the_contact_force_limit_is_per_driver_and_a_sensor_that_cannot_resolve_
     assert "resolves forces of 0.62 N" in reason and "stops at 0.5 N" in reason
     assert unresolvable(move, floor(0.124), 5.0) == "" and unresolvable(thesis, None, 5.0) == ""
     assert unresolvable(thesis, floor(0.124), 0.0) == ""  # noise_limit_sigmas 0: nothing checked
+    # The offset moving with the pose counts too: 1.5 N passes on the noise alone, not with a 0.3 N
+    # residual of a bias map (hypot(0.62, 5 x 0.3) = 1.6 N), and the reason says so.
+    assert unresolvable(move, floor(0.124), 5.0, pose=(0.0, 0.0)) == ""
+    reason = unresolvable(move, floor(0.124), 5.0, pose=(0.3, 0.0))
+    assert "resolves forces of 1.6 N" in reason and "offset's change with the pose, 0.3 N" in reason
     # A current estimate (1.05 N after the filter, resolves 5.3 N): the follower's 5 N push is in its noise,
     # and force tracking's +-1.5 N is inside the +-2.1 N its input wanders; the e-series' 0.24 N is not.
     (follower, surface) = by_name(["follower_z", "surface_following"], g)

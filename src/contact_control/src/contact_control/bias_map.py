@@ -12,9 +12,12 @@ u = R_world_sensor^T g in the sensor frame reads, beyond the tool the settings a
   one row of coefficients per wrench component: what friction and model errors leave, smooth in q.
 
 Both are linear in the unknowns: one least-squares problem, with a small ridge on the residual's
-non-constant terms so that an axis the sweep barely moves stays at zero. Every fifth pose is held out to
-measure what the map leaves (`held_out_std`), then the map is fitted on all of them. The degree with the
-smaller held-out error is kept. Outside the swept joint ranges q is clamped to them: the polynomial is not
+non-constant terms so that an axis the sweep barely moves stays at zero. What the map leaves is measured on
+poses it was not fitted on (`held_out_std`: five fits, each holding out a fifth of the poses), then the map
+is fitted on all of them; the degree with the smaller held-out error is kept. A held-out pose's own reading
+carries the sensor's noise, which the noise floor counts already: `error_std` takes it out (held-out
+variance minus the noise variance the fitted poses show, unbiased for the terms fitted) and is what
+contact_control adds to its floor. Outside the swept joint ranges q is clamped to them: the polynomial is not
 extrapolated.
 """
 
@@ -33,7 +36,7 @@ from compliant_common.typedefs import FloatArray
 
 __all__ = ["BiasMap", "BiasMapError", "MapSample", "ResidualPredictor", "fit_bias_map", "load_bias_map"]
 
-HOLD_OUT_EVERY = 5  # every fifth pose is held out to measure what the map leaves
+HOLD_OUT_EVERY = 5  # folds: each fit holds out every fifth pose, from another start
 RIDGE = 1e-2  # on the residual's non-constant terms (scaled joint positions are of order 1)
 MIN_SCALE = 0.05  # [rad] a joint that moves less in the sweep is scaled as if it moved this much
 SAMPLES_PER_TERM = 1.5  # poses per residual term a degree needs to be tried
@@ -89,7 +92,8 @@ class BiasMap:
         coefficients: 6 rows (fx..tz) of one coefficient per monomial.
         held_out_std: Per component, the std of what the map leaves on the held-out poses [N, Nm].
         fit_std: The same on the poses it was fitted on.
-        samples: Poses fitted on; held_out: poses held out for `held_out_std`.
+        error_std: `held_out_std` without the held-out readings' own noise: the map's error [N, Nm].
+        samples: Poses fitted on; held_out: poses `held_out_std` was measured on.
         command: The command that reruns the calibration.
     """
 
@@ -105,6 +109,7 @@ class BiasMap:
     coefficients: tuple[tuple[float, ...], ...]
     held_out_std: tuple[float, ...]
     fit_std: tuple[float, ...]
+    error_std: tuple[float, ...]
     samples: int
     held_out: int
     command: str = ""
@@ -112,12 +117,12 @@ class BiasMap:
     @property
     def residual_force(self) -> float:
         """The largest held-out force std [N]: what the map cannot explain."""
-        return max(self.held_out_std[:3])
+        return max(self.error_std[:3])
 
     @property
     def residual_torque(self) -> float:
         """The largest held-out torque std [Nm]."""
-        return max(self.held_out_std[3:])
+        return max(self.error_std[3:])
 
     def predict(self, q: Sequence[float], gravity: Sequence[float]) -> list[float]:
         """The offset at joint positions `q` with gravity `gravity` in the sensor frame [N, Nm]."""
@@ -143,10 +148,12 @@ class BiasMap:
     def describe(self) -> str:
         f = ", ".join(f"{v:.3f}" for v in self.held_out_std[:3])
         t = ", ".join(f"{v:.4f}" for v in self.held_out_std[3:])
+        e = ", ".join(f"{v:.3f}" for v in self.error_std[:3])
         h = ", ".join(f"{v * 1e3:.2f}" for v in self.moment)
         return (f"bias map over {len(self.joint_names)} joints from {self.samples} poses: load error "
-                f"{self.mass:+.4f} kg (moment {h} g m), residual of degree {self.degree}; left on "
-                f"{self.held_out} held-out poses: force std [{f}] N, torque std [{t}] Nm")
+                f"{self.mass:+.4f} kg (moment {h} g m), residual of degree {self.degree}; left on the "
+                f"{self.held_out} held-out poses: force std [{f}] N, torque std [{t}] Nm; without their "
+                f"readings' noise the map's force error [{e}] N")
 
     # --- file ---
     def to_yaml(self) -> str:
@@ -167,6 +174,7 @@ class BiasMap:
             },
             "held_out_std": nums(self.held_out_std),
             "fit_std": nums(self.fit_std),
+            "error_std": nums(self.error_std),
             "samples": self.samples,
             "held_out": self.held_out,
             "command": self.command,
@@ -229,21 +237,28 @@ def fit_bias_map(
         raise BiasMapError("a pose has NaN/inf values: sample it again")
     center = 0.5 * (q.min(axis=0) + q.max(axis=0))
     scale = np.maximum(q.std(axis=0), MIN_SCALE)
-    held = np.zeros(len(rows), dtype=bool)
-    held[HOLD_OUT_EVERY - 1::HOLD_OUT_EVERY] = True
-    best: tuple[float, int, FloatArray] | None = None
+    fold = np.arange(len(rows)) % HOLD_OUT_EVERY
+    training = len(rows) - int(np.sum(fold == 0))
+    best: tuple[float, int, FloatArray, FloatArray] | None = None
     for degree in sorted(set(degrees)):
         terms = _terms(n, degree)
-        if len(terms) * SAMPLES_PER_TERM > (~held).sum() and degree > min(degrees):
+        if len(terms) * SAMPLES_PER_TERM > training and degree > min(degrees):
             continue  # too few poses for this many terms
-        x = _solve(q[~held], u[~held], w[~held], center, scale, terms)[0]
-        error = _residuals(x, q[held], u[held], w[held], center, scale, terms)
-        held_std = np.sqrt(np.mean(error**2, axis=0))
+        held_sq, noise = np.zeros(6), np.zeros(6)
+        for k in range(HOLD_OUT_EVERY):
+            held, fit = fold == k, fold != k
+            x = _solve(q[fit], u[fit], w[fit], center, scale, terms)[0]
+            held_sq += np.sum(_residuals(x, q[held], u[held], w[held], center, scale, terms) ** 2, axis=0)
+            fitted = _residuals(x, q[fit], u[fit], w[fit], center, scale, terms)
+            dof = max(1, int(fit.sum()) - len(terms) - 1)  # per component: its terms and the load's share
+            noise += np.sum(fitted**2, axis=0) / dof / HOLD_OUT_EVERY
+        held_std = np.sqrt(held_sq / len(rows))
+        map_error = np.sqrt(np.maximum(held_std**2 - noise, 0.0))
         score = float(np.sum(held_std[:3] ** 2) + np.sum((held_std[3:] * 10.0) ** 2))  # 10 Nm ~ 1 N at 0.1 m
         if best is None or score < best[0]:
-            best = (score, degree, held_std)
+            best = (score, degree, held_std, map_error)
     assert best is not None
-    _, degree, held_std = best
+    _, degree, held_std, map_error = best
     terms = _terms(n, degree)
     x, _ = _solve(q, u, w, center, scale, terms)
     fit_error = _residuals(x, q, u, w, center, scale, terms)
@@ -255,7 +270,8 @@ def fit_bias_map(
         coefficients=tuple(tuple(r) for r in coefficients.tolist()),
         held_out_std=tuple(held_std.tolist()),
         fit_std=tuple(np.sqrt(np.mean(fit_error**2, axis=0)).tolist()),
-        samples=len(rows), held_out=int(held.sum()), command=command,
+        error_std=tuple(map_error.tolist()),
+        samples=len(rows), held_out=len(rows), command=command,
     )
 
 
@@ -353,6 +369,7 @@ def _from_doc(doc: dict[str, Any]) -> BiasMap:
         coefficients=tuple(_floats(r, k, f"residual.coefficients[{i}]") for i, r in enumerate(rows)),
         held_out_std=_floats(doc["held_out_std"], 6, "held_out_std"),
         fit_std=_floats(doc.get("fit_std", [0.0] * 6), 6, "fit_std"),
+        error_std=_floats(doc.get("error_std", doc["held_out_std"]), 6, "error_std"),
         samples=int(doc.get("samples", 0)), held_out=int(doc.get("held_out", 0)),
         command=str(doc.get("command", "")),
     )

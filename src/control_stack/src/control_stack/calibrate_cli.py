@@ -16,7 +16,7 @@ from contact_control.bias_map import BiasMapError, MapSample, fit_bias_map
 from contact_control.params import ParamError, load_settings
 from contact_control.preprocess import WrenchPreprocessor
 
-from control_stack.calibration import Box, CalibrationError, plan_sweep
+from control_stack.calibration import Box, CalibrationError, plan_sweep, read_poses
 
 __all__ = ["main"]
 
@@ -111,7 +111,8 @@ def _run(args: argparse.Namespace) -> int:
     jog, _ = JogSettings.from_params_with_warnings(rospy.get_param(jog_ns, {}), jog_ns)
     arm = JogCalcs(jog, rospy.get_param("robot_description")).model
     tool = WrenchPreprocessor(load_settings({**rospy.get_param(cc_ns, {}), "bias_map": ""}))
-    inputs = _Inputs(args.joint_states, rospy.resolve_name(settings.ft_in_topic, cc_ns))
+    joint_topic = args.joint_states or rospy.resolve_name(jog.joint_topic, jog_ns)  # the arm's, as jog_arm's
+    inputs = _Inputs(joint_topic, rospy.resolve_name(settings.ft_in_topic, cc_ns))
     tf = tf2_ros.Buffer()
     tf2_ros.TransformListener(tf)
     move_name = rospy.resolve_name(args.named_poses) + "/move_to_joints"
@@ -121,18 +122,22 @@ def _run(args: argparse.Namespace) -> int:
     while not inputs.names and time.monotonic() < deadline:
         time.sleep(0.05)  # start-up: the first joint state
     if not inputs.names:
-        print(f"calibrate_bias: no joint state on {args.joint_states}", file=sys.stderr)
+        print(f"calibrate_bias: no joint state on {joint_topic}", file=sys.stderr)
         return 1
     names, start = inputs.names, list(inputs.positions)
     model_q = [start[names.index(n)] for n in arm.joint_names]
     try:
-        poses = plan_sweep(arm, model_q, Box.parse(args.box), args.tilt, args.count)
+        if args.poses:
+            poses = read_poses(args.poses, arm.joint_names)
+            where = f"from {args.poses}"
+        else:
+            poses = plan_sweep(arm, model_q, Box.parse(args.box), args.tilt, args.count)
+            where = f"in the box {args.box} m around the arm's pose, tilted up to {args.tilt:g} rad"
     except CalibrationError as err:
         print(f"calibrate_bias: {err}", file=sys.stderr)
         return 2
-    print(f"calibrate_bias: {len(poses)} poses in the box {args.box} m around the arm's pose, tilted up "
-          f"to {args.tilt:g} rad; the wrench of {settings.ft_in_topic} in {settings.ft_sensor_frame}",
-          flush=True)
+    print(f"calibrate_bias: {len(poses)} poses {where}; the wrench of {settings.ft_in_topic} in "
+          f"{settings.ft_sensor_frame}", flush=True)
     samples: list[MapSample] = []
     skipped = 0
     for k, q in enumerate(poses, start=1):
@@ -196,6 +201,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--box", default="-0.1,0.1,-0.1,0.1,-0.05,0.1",
                         help="tool tip offsets from the current pose, base axes [m]: "
                         "xlow,xhigh,ylow,yhigh,zlow,zhigh")
+    parser.add_argument("--poses", default="", help="a YAML list of joint poses ({joint: position}) to use "
+                        "instead of the box's sweep")
     parser.add_argument("--tilt", type=float, default=0.3, help="tool tilt about the base's X and Y [rad]")
     parser.add_argument("--count", type=int, default=60,
                         help="poses in the sweep (10 or more; 60 let a 6-joint arm fit a quadratic)")
@@ -203,7 +210,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--contact-control", default="contact_control_node", help="its node name")
     parser.add_argument("--jog-arm", default="jog_arm_server", help="its node name (joints and tip)")
     parser.add_argument("--named-poses", default="named_poses", help="named_poses' node name")
-    parser.add_argument("--joint-states", default="joint_states")
+    parser.add_argument("--joint-states", default="", help="sensor_msgs/JointState topic (default jog_arm's)")
     import rospy
 
     args = parser.parse_args(rospy.myargv(list(sys.argv[1:] if argv is None else argv)))

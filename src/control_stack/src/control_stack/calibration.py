@@ -15,11 +15,12 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
+import yaml
 from compliant_common.errors import StackError
 from compliant_common.typedefs import FloatArray
 from jog_arm.kinematics import ArmModel
 
-__all__ = ["Box", "CalibrationError", "plan_sweep"]
+__all__ = ["Box", "CalibrationError", "plan_sweep", "read_poses"]
 
 # Tilt directions (about the base's X, Y) [x tilt]: level, both ways about each axis and four diagonals.
 TILTS: tuple[tuple[float, float], ...] = (
@@ -122,3 +123,27 @@ def _nearest_first(q0: FloatArray, poses: list[FloatArray]) -> list[FloatArray]:
         at = left.pop(k)
         ordered.append(at)
     return ordered
+
+
+def read_poses(path: str, joint_names: Sequence[str]) -> list[FloatArray]:
+    """Joint poses from a YAML list of {joint: position} (every arm joint in each), in `joint_names` order.
+
+    Raises:
+        CalibrationError: Unreadable, not a list of mappings, a joint missing (named), or fewer than 10.
+    """
+    try:
+        with open(path) as handle:
+            doc = yaml.safe_load(handle)
+    except (OSError, yaml.YAMLError) as err:
+        raise CalibrationError(f"poses {path}: {err}") from err
+    if not isinstance(doc, list) or not all(isinstance(p, dict) for p in doc):
+        raise CalibrationError(f"poses {path}: expected a list of {{joint: position}} mappings")
+    poses = []
+    for k, pose in enumerate(doc):
+        missing = [n for n in joint_names if n not in pose]
+        if missing:
+            raise CalibrationError(f"poses {path}: pose {k} has no position for {missing}")
+        poses.append(np.array([float(pose[n]) for n in joint_names]))
+    if len(poses) < 10:
+        raise CalibrationError(f"poses {path}: a sweep needs 10 or more poses, got {len(poses)}")
+    return poses

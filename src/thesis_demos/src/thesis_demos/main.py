@@ -48,16 +48,21 @@ def _args(argv: Sequence[str]) -> argparse.Namespace:
 
 
 def unresolvable(scenario: Any, floor: NoiseFloor | None, sigmas: float,
-                 global_force: float = ContactControlSettings.global_max_force) -> str:
+                 global_force: float = ContactControlSettings.global_max_force,
+                 pose: tuple[float, float] = (0.0, 0.0)) -> str:
     """Why the sensor cannot do `scenario` ("" if it can), from contact_control's noise floor, its
     noise_limit_sigmas and global_max_force: a force or torque limit, or a push, below what it resolves; a
     push whose raw noise (PUSH_NOISE_SIGMAS stds) reaches the global limit; or force tracking whose tolerance
     the noise the laws act on (+- TRACKING_NOISE_SIGMAS filtered stds) exceeds."""
     if floor is None or sigmas <= 0.0:
         return ""
+    # `pose`: how far the offset moves over the workspace (the bias map's held-out residual or the declared
+    # pose offset), counted beside the noise as contact_control counts it.
     force, torque = floor.resolvable(sigmas)
-    resolves = (f"the sensor resolves forces of {force:.2g} N and more (contact_control's noise floor times "
-                "its noise_limit_sigmas)")
+    force, torque = math.hypot(force, sigmas * pose[0]), math.hypot(torque, sigmas * pose[1])
+    moving = f" and the offset's change with the pose, {pose[0]:.2g} N," if pose[0] > 0.0 else ""
+    resolves = (f"the sensor resolves forces of {force:.2g} N and more (contact_control's noise "
+                f"floor{moving} times its noise_limit_sigmas)")
     laws = list(scenario.laws.values())
     if scenario.follow_up:
         laws += list(scenario.follow_up.laws.values())
@@ -122,13 +127,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         floor = runner.noise_floor()
         sigmas = runner.contact_setting("noise_limit_sigmas")
         global_force = runner.contact_setting("global_max_force")
+        pose = runner.pose_residual()
     except (TimeoutError, RuntimeError) as exc:  # the stack never got ready: why, not a traceback
         print(f"run_demos: the stack is not ready for the demonstrations: {exc}", file=sys.stderr, flush=True)
         return 1
     for scenario in scenarios:
         if scenario.name in cannot:
             continue
-        reason = unresolvable(scenario, floor, sigmas, global_force)
+        reason = unresolvable(scenario, floor, sigmas, global_force, pose)
         if reason:  # the sensor cannot tell this demonstration's force limit from its noise
             cannot[scenario.name] = reason
             print(f"[CANNOT] {scenario.name}: {reason}", flush=True)

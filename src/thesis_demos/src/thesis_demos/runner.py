@@ -358,6 +358,24 @@ class DemoRunner:
         default = getattr(ContactControlSettings, name)
         return float(rospy.get_param(f"{self.names.contact_control}/{name}", default))
 
+    def pose_residual(self) -> tuple[float, float]:
+        """How far contact_control takes its sensor's offset to move over the workspace beyond the noise
+        (force [N], torque [Nm]): its bias map's held-out residual, else its pose_offset_force / _torque.
+
+        Raises:
+            RuntimeError: The bias map file cannot be read (the node would not have started either).
+        """
+        from contact_control.bias_map import BiasMapError, load_bias_map
+
+        path = str(rospy.get_param(f"{self.names.contact_control}/bias_map", ""))
+        if path:
+            try:
+                loaded = load_bias_map(path)
+            except BiasMapError as err:
+                raise RuntimeError(str(err)) from err
+            return loaded.residual_force, loaded.residual_torque
+        return self.contact_setting("pose_offset_force"), self.contact_setting("pose_offset_torque")
+
     def noise_floor(self, timeout: float = 10.0) -> NoiseFloor | None:
         """contact_control's noise floor as its ~status reports it (measured while zeroing); None when it
         reports none (not zeroed, or an older node)."""
