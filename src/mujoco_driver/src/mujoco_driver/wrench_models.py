@@ -37,7 +37,8 @@ __all__ = ["RateDivider", "Reflex", "WrenchModel", "change_frame", "gravity_wren
 GRAVITY = np.array([0.0, 0.0, -9.81])
 # Damping of the least-squares inverse: none while the Jacobian's smallest singular value (mixed units: m
 # for the linear rows) is over SINGULAR_BAND, growing to DAMPING at a singularity: the gain stays under
-# 13 N per Nm. libfranka zeroes F_ext below 0.08 (libfranka #76); the robots' start poses are at 0.21.
+# 13 N per Nm. A torque-sensing arm's driver zeroes its estimate below 0.08 (the mujoco_driver README's
+# Sensor errors); the robots' start poses are at 0.21.
 SINGULAR_BAND = 0.08
 DAMPING = 0.05
 
