@@ -247,9 +247,8 @@ def fit_bias_map(
         held_sq, noise = np.zeros(6), np.zeros(6)
         for k in range(HOLD_OUT_EVERY):
             held, fit = fold == k, fold != k
-            x = _solve(q[fit], u[fit], w[fit], center, scale, terms)[0]
+            x, fitted = _solve(q[fit], u[fit], w[fit], center, scale, terms)
             held_sq += np.sum(_residuals(x, q[held], u[held], w[held], center, scale, terms) ** 2, axis=0)
-            fitted = _residuals(x, q[fit], u[fit], w[fit], center, scale, terms)
             dof = max(1, int(fit.sum()) - len(terms) - 1)  # per component: its terms and the load's share
             noise += np.sum(fitted**2, axis=0) / dof / HOLD_OUT_EVERY
         held_std = np.sqrt(held_sq / len(rows))
@@ -260,8 +259,7 @@ def fit_bias_map(
     assert best is not None
     _, degree, held_std, map_error = best
     terms = _terms(n, degree)
-    x, _ = _solve(q, u, w, center, scale, terms)
-    fit_error = _residuals(x, q, u, w, center, scale, terms)
+    x, fit_error = _solve(q, u, w, center, scale, terms)
     coefficients = x[4:].reshape(6, len(terms))
     return BiasMap(
         joint_names=tuple(joint_names), frame=frame, mass=float(x[0]), moment=(x[1], x[2], x[3]),
@@ -292,6 +290,7 @@ def _design(q: FloatArray, u: FloatArray, center: FloatArray, scale: FloatArray,
 
 def _solve(q: FloatArray, u: FloatArray, w: FloatArray, center: FloatArray, scale: FloatArray,
            terms: Sequence[tuple[int, ...]]) -> tuple[FloatArray, FloatArray]:
+    """The least-squares unknowns and what they leave on these poses (a row per pose, fx..tz)."""
     a = _design(q, u, center, scale, terms)
     y = w.reshape(-1)
     k = len(terms)
@@ -306,7 +305,7 @@ def _solve(q: FloatArray, u: FloatArray, w: FloatArray, center: FloatArray, scal
             "the poses' orientations are too alike to separate the load's mass and centre of mass: "
             "tilt the tool about two axes in the sweep")
     x = np.linalg.lstsq(a_aug, y_aug, rcond=None)[0]
-    return x, a @ x - y
+    return x, (a @ x - y).reshape(-1, 6)
 
 
 def _residuals(x: FloatArray, q: FloatArray, u: FloatArray, w: FloatArray, center: FloatArray,

@@ -5,6 +5,7 @@ Plain floats: the node composes at most a few per cycle, and numpy's per-call ov
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 __all__ = [
@@ -15,6 +16,7 @@ __all__ = [
     "quaternion_matrix",
     "rotate_twist",
     "rotation",
+    "rotation_angle",
     "transform",
     "transpose_times",
 ]
@@ -59,6 +61,12 @@ def transform(translation: Sequence[float], quaternion: Sequence[float]) -> Rows
     """4x4 from a translation (x, y, z) and a quaternion (x, y, z, w)."""
     r = quaternion_matrix(*quaternion)
     return [r[0] + [translation[0]], r[1] + [translation[1]], r[2] + [translation[2]], [0.0, 0.0, 0.0, 1.0]]
+
+
+def rotation_angle(a: Sequence[Sequence[float]], b: Sequence[Sequence[float]]) -> float:
+    """Angle [rad] of the rotation between two rotation matrices (3x3 rows)."""
+    trace = sum(a[0][i] * b[0][i] + a[1][i] * b[1][i] + a[2][i] * b[2][i] for i in range(3))
+    return math.acos(max(-1.0, min(1.0, (trace - 1.0) / 2.0)))
 
 
 def rotation(t: Sequence[Sequence[float]]) -> Rows:

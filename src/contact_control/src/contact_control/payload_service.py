@@ -12,6 +12,7 @@ from collections.abc import Callable, Sequence
 import rospy
 from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 
+from contact_control.frames import rotation_angle
 from contact_control.payload import PayloadError, fit_payload, gravity_in_sensor
 
 __all__ = ["PayloadServices"]
@@ -80,7 +81,7 @@ class PayloadServices:
         if not got:
             return TriggerResponse(success=False, message=f"{len(buffer)} wrenches in {SAMPLE_TIMEOUT} s")
         r1 = self._rotation()
-        turned = _angle(r0, r1)
+        turned = rotation_angle(r0, r1)
         if turned > MAX_TURN:
             return TriggerResponse(success=False, message=f"the sensor turned {turned:.3f} rad meanwhile")
         oriented = [self._oriented(w) for w in buffer]
@@ -110,8 +111,3 @@ class PayloadServices:
         self.samples.clear()
         return TriggerResponse(success=True, message=f"{count} samples cleared")
 
-
-def _angle(a: Sequence[Sequence[float]], b: Sequence[Sequence[float]]) -> float:
-    """Angle [rad] of the rotation between two rotation matrices."""
-    trace = sum(a[0][i] * b[0][i] + a[1][i] * b[1][i] + a[2][i] * b[2][i] for i in range(3))
-    return math.acos(max(-1.0, min(1.0, (trace - 1.0) / 2.0)))

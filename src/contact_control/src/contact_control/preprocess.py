@@ -205,10 +205,7 @@ class WrenchPreprocessor:
         Raises:
             PreprocessError: the reading is not finite or the orientation is missing while tool_mass > 0.
         """
-        self._bias = self.bias_estimate(raw, R_world_sensor)
-        self._offset = [b + p for b, p in zip(self._bias, self._pose_bias, strict=True)]
-        if self._filter:
-            self._filter.reset()
+        self.set_bias(self.bias_estimate(raw, R_world_sensor))
         return tuple(self._bias)
 
     def bias_estimate(self, raw: Sequence[float], R_world_sensor: Matrix | None = None) -> list[float]:

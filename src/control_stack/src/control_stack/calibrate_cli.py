@@ -13,6 +13,7 @@ from collections.abc import Sequence
 
 import numpy as np
 from contact_control.bias_map import BiasMapError, MapSample, fit_bias_map
+from contact_control.frames import quaternion_matrix, rotation_angle
 from contact_control.params import ParamError, load_settings
 from contact_control.preprocess import WrenchPreprocessor
 
@@ -82,16 +83,7 @@ def _sensor_rotation(buffer, fixed: str, frame: str) -> np.ndarray:  # type: ign
     import rospy
 
     q = buffer.lookup_transform(fixed, frame, rospy.Time(0), rospy.Duration(1.0)).transform.rotation
-    x, y, z, w = q.x, q.y, q.z, q.w
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
-
-
-def _angle(a: np.ndarray, b: np.ndarray) -> float:
-    return math.acos(max(-1.0, min(1.0, (float(np.trace(a.T @ b)) - 1.0) / 2.0)))
+    return np.array(quaternion_matrix(q.x, q.y, q.z, q.w))
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -184,7 +176,7 @@ def _sample(inputs: _Inputs, tf, settings, tool: WrenchPreprocessor,  # type: ig
     time.sleep(SAMPLE_TIME)  # collecting: the subscribers fill the buffers meanwhile
     wrenches, qs = inputs.stop_sampling()
     r1 = _sensor_rotation(tf, settings.fixed_frame, settings.ft_sensor_frame)
-    if len(wrenches) < 5 or not qs or _angle(r0, r1) > MAX_TURN:
+    if len(wrenches) < 5 or not qs or rotation_angle(r0.tolist(), r1.tolist()) > MAX_TURN:
         return None
     weight = tool.gravity_wrench(r1.tolist())
     net = np.mean([tool.oriented(w) for w in wrenches], axis=0) - np.array(weight)
