@@ -117,3 +117,25 @@ def test_a_yaml_of_joint_poses_is_read_in_the_arms_order_and_checked(tmp_path) -
     short.write_text("- {a: 0.0, b: 0.0}\n" * 3)
     with pytest.raises(CalibrationError, match="10 or more"):
         read_poses(str(short), names)
+
+
+def test_a_joint_state_the_map_cannot_use_holds_the_arm_and_says_why(tmp_path) -> None:
+    """The map's offset is unknown at a NaN joint position (or a short joint state): the follower's twist is
+    zero, the status says why, and the next usable joint state lets the push move the arm again."""
+    path = calibrate(Cell("ur5"), tmp_path / "bias_map.yaml")
+    cell = Cell("ur5", params={"bias_map": path})
+    for _ in range(150):  # zeroing at the start pose
+        cell.step((0.0, 0.0, 0.0))
+    cell.follower_z()
+    p = cell.pipeline
+    for bad, why in (([float("nan"), *cell.q[1:].tolist()], "a joint position is not finite"),
+                     (cell.q[:3].tolist(), "3 positions for 6 joints")):
+        p.on_joint_state(cell.names, bad, cell.t)
+        for _ in range(50):  # 0.1 s of a 10 N push up
+            cell.t += 0.002
+            twist = p.on_wrench(cell.wrench((0.0, 0.0, 10.0)), cell.cc.ft_sensor_frame, cell.t, cell.t).twist
+            assert twist is None or not any(twist), twist
+        result = p.contact.ctrl.last_result
+        assert why in result.message, result.message
+    moved = [cell.step((0.0, 0.0, 10.0)) for _ in range(100)]  # usable joint states again
+    assert any(t is not None and t[2] > 0.0 for t in moved)

@@ -30,6 +30,7 @@ from contact_control.events import ContactEvent, EventWatch
 from contact_control.frames import IDENTITY, Rows, compose, inverse, rotate_twist, rotation, transpose_times
 from contact_control.laws import AxisLaw
 from contact_control.params import ContactControlSettings
+from contact_control.preprocess import is_finite6
 from contact_control.request import (
     FAILURE,
     SUCCESS,
@@ -91,6 +92,7 @@ class ContactStage:
             self.ctrl.pose_residual = (self.bias_map.residual_force, self.bias_map.residual_torque)
         self._predict: ResidualPredictor | None = None
         self._joint_names: Sequence[str] = ()
+        #: Why the bias map's offset is unknown ("": known, or no map): wrenches hold meanwhile.
         self._joints_missing = "no joint state yet" if self.bias_map is not None else ""
         self._gravity = self.ctrl.preprocessor.weighs
         #: The frames a cycle may look up besides the fixed one.
@@ -181,12 +183,17 @@ class ContactStage:
             try:
                 predict = self._predict = self.bias_map.predictor(names)
             except BiasMapError as err:
-                if str(err) != self._joints_missing:
-                    self.notes.append(("error", f"{err}: holding (zero twist)"))
-                    self._joints_missing = str(err)
+                self._joints_missing = str(err)
                 return
         self._joint_names = names
-        self.ctrl.preprocessor.set_pose_bias(predict(positions))
+        if len(positions) != len(names):
+            self._joints_missing = f"a joint state with {len(positions)} positions for {len(names)} joints"
+            return
+        offset = predict(positions)
+        if not is_finite6(offset):  # a NaN position: the offset is unknown, not zero
+            self._joints_missing = "a joint position is not finite"
+            return
+        self.ctrl.preprocessor.set_pose_bias(offset)
         self._joints_missing = ""
 
     def on_wrench(
@@ -199,10 +206,10 @@ class ContactStage:
         self._have_frames = False
         try:
             if self._joints_missing:
-                raise LookupError(f"the bias map's joints: {self._joints_missing}")
+                raise LookupError(f"the bias map's offset: {self._joints_missing}")
             T_cs, R_ws, eef, R_fc, R_cc = self._frames(sensor_frame)
         except LookupError as err:
-            why = f"no transform: {err}"
+            why = f"no transform: {err}" if not self._joints_missing else str(err)
             if why != self._tf_missing:  # logged once per change: only ~status said so before
                 self.notes.append(("warn", f"{why}: holding (zero twist) until it comes"))
                 self._tf_missing = why
