@@ -85,7 +85,8 @@ def test_killing_the_driver_shows_error_with_the_reason_within_a_second(ros_node
             expected = "[ OK ] /contact_control_node - idle, sensor fresh"
             assert expected in shown.stdout, shown.stdout + shown.stderr
             assert "    - wrench rate [Hz]: " in shown.stdout
-            for node in ("/jog_arm_server", "/mujoco_driver", "/named_poses", "/teach"):  # every node of ours
+            ours = ("/jog_arm_server", "/mujoco_driver", "/named_poses", "/teach", "/task_server")
+            for node in ours:  # every node of ours
                 assert f"] {node} - " in shown.stdout, shown.stdout
             killed = time.monotonic()
             driver.stop()

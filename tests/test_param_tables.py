@@ -21,6 +21,7 @@ EXPECTED = {
     "named_poses": "named_poses.params:PARAMETERS",
     "manipulator_control_gui": "manipulator_control_gui.params:PARAMETERS",
     "teach": "teach.params:PARAMETERS",
+    "contact_tasks": "contact_tasks.params:PARAMETERS",
 }
 
 

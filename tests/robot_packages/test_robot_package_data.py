@@ -20,16 +20,18 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 ROBOTS = ("ur5_custom", "panda_custom")  # the hand-written ones (vendor drivers, joint counts)
 # Every robot package, generated ones (make robot) included: the same launch files and wiring.
 ALL_ROBOTS = tuple(sorted(p.name for p in (ROOT / "src").iterdir() if p.name.endswith("_custom")))
-_STACK = {"/robot_state_publisher", "/jog_arm_server", "/contact_control_node", "/named_poses", "/teach"}
+_STACK = {"/robot_state_publisher", "/jog_arm_server", "/contact_control_node", "/named_poses", "/teach",
+          "/task_server"}
 # single_process by default
-_SIM_STACK = {"/robot_state_publisher", "/control_stack", "/mujoco_driver", "/named_poses", "/teach"}
+_SIM_STACK = {"/robot_state_publisher", "/control_stack", "/mujoco_driver", "/named_poses", "/teach",
+              "/task_server"}
 LAUNCH_FILES = {
     "sim.launch": _SIM_STACK,
     "hardware.launch": _SIM_STACK - {"/mujoco_driver"},  # the same single process as in simulation
     "keyboard.launch": {*_SIM_STACK, "/key_to_twist"},
 }
 OWN_LAUNCH_FILES = sorted(
-    [p for pkg in (*ALL_ROBOTS, "mujoco_driver", "named_poses", "teach")
+    [p for pkg in (*ALL_ROBOTS, "mujoco_driver", "named_poses", "teach", "contact_tasks")
      for p in (ROOT / "src" / pkg / "launch").rglob("*.launch*")]
 )
 # Frames a real driver provides through tf, not the URDF (franka_state_controller's EE frame).

@@ -1,0 +1,291 @@
+"""task_server: the `~execute` action (compliant_control_msgs/ExecuteTask) over `run.TaskRun` (the README).
+
+A thin adapter: tf gives the tool's pose, contact_control's `~status` the wrench and whether the step's move
+runs, its `~events` the touches; the run's commands become ConfigureLaws calls, `~path_reference` messages
+and `~stop` calls. One task at a time; cancel stops the arm. Inputs only while a task runs: idle, the node
+costs the stack nothing.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import threading
+from collections.abc import Sequence
+
+import actionlib
+import numpy as np
+import rospkg
+import rospy
+import tf2_ros
+from compliant_common.diagnostics import OK, Report
+from compliant_common.ros_diagnostics import DiagnosticsPublisher
+from compliant_common.typedefs import FloatArray
+from compliant_control_msgs.msg import (
+    ContactControlStatus,
+    ContactEvent,
+    ExecuteTaskAction,
+    ExecuteTaskFeedback,
+    ExecuteTaskGoal,
+    ExecuteTaskResult,
+    PathReference,
+)
+from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsRequest
+from contact_control.frames import matrix_quaternion, quaternion_matrix
+from std_srvs.srv import Trigger
+
+from contact_tasks.params import TaskServerSettings, load_settings
+from contact_tasks.run import FAILED, RUNNING, SUCCEEDED, Command, Observation, TaskRun
+from contact_tasks.task import AXIS_NAMES, Task, TaskError
+from contact_tasks.task_file import load_task, load_task_file
+
+__all__ = ["TaskServer", "main"]
+
+_TF_ERRORS = (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException)
+_LAW_FIELDS = ("law", "damping", "stiffness", "velocity", "force_limit", "max_travel", "exceeded_action",
+               "target_force")
+
+
+class TaskServer:
+    """`~execute`; see the module docstring."""
+
+    def __init__(self, s: TaskServerSettings, fixed_frame: str, eef_frame: str, tasks_dir: str) -> None:
+        self.s, self.fixed_frame, self.eef_frame, self.tasks_dir = s, fixed_frame, eef_frame, tasks_dir
+        cc = rospy.resolve_name(s.contact_control_node)
+        self._cc = cc
+        self._ref_pub = rospy.Publisher(cc + "/path_reference", PathReference, queue_size=1, tcp_nodelay=True)
+        self._configure = rospy.ServiceProxy(rospy.resolve_name("configure_laws"), ConfigureLaws)
+        self._stop = rospy.ServiceProxy(cc + "/stop", Trigger)
+        self._tf = tf2_ros.Buffer()
+        self._listener: tf2_ros.TransformListener | None = None
+        self._lock = threading.Lock()
+        self._status: ContactControlStatus | None = None
+        self._touched = self._released = False
+        self._not_before = math.inf  # events from before the task are ignored
+        self._laws_at = math.inf
+        self._subs: list[rospy.Subscriber] = []
+        self._running = ""  # "task 'name', step 'step'" while one runs
+        self._last = "idle"
+        self._server = actionlib.SimpleActionServer("~execute", ExecuteTaskAction, self._execute,
+                                                    auto_start=False)
+        self._server.start()
+        self._health = DiagnosticsPublisher(self._health_report)
+
+    def _health_report(self) -> Report:
+        """/diagnostics: the running task and step, or the last task's outcome. Every fault here is a goal's
+        answer, so the level stays OK."""
+        report = Report(rospy.get_name())
+        with self._lock:
+            report.check(OK, self._running or self._last)
+        report.value("tasks_dir", self.tasks_dir)
+        return report
+
+    # inputs
+
+    def _listen(self) -> None:
+        if self._listener is None:
+            self._listener = tf2_ros.TransformListener(self._tf)
+        self._subs = [
+            rospy.Subscriber(self._cc + "/status", ContactControlStatus, self._on_status, queue_size=1),
+            rospy.Subscriber(self._cc + "/events", ContactEvent, self._on_event, queue_size=50),
+        ]
+
+    def _unlisten(self) -> None:
+        for sub in self._subs:
+            sub.unregister()
+        self._subs = []
+        with self._lock:
+            self._status = None
+
+    def _wait_for_inputs(self) -> tuple[ContactControlStatus | None, FloatArray | None]:
+        """The first status and tool pose, waiting up to `status_timeout` (the time's own clock)."""
+        deadline = rospy.get_time() + self.s.status_timeout
+        poll = rospy.Rate(50.0)
+        while not rospy.is_shutdown():
+            with self._lock:
+                status = self._status
+            tool = self._tool()
+            if (status is not None and tool is not None) or rospy.get_time() >= deadline:
+                return status, tool
+            poll.sleep()
+        return None, None
+
+    def _on_status(self, msg: ContactControlStatus) -> None:
+        with self._lock:
+            self._status = msg
+
+    def _on_event(self, msg: ContactEvent) -> None:
+        with self._lock:
+            if msg.header.stamp.to_sec() >= self._not_before:
+                self._touched |= msg.type == ContactEvent.TOUCH
+                self._released |= msg.type == ContactEvent.RELEASE
+
+    def _tool(self) -> FloatArray | None:
+        try:
+            tf = self._tf.lookup_transform(self.fixed_frame, self.eef_frame, rospy.Time(0))
+        except _TF_ERRORS:
+            return None
+        p, q = tf.transform.translation, tf.transform.rotation
+        pose = np.eye(4)
+        pose[:3, :3] = quaternion_matrix(q.x, q.y, q.z, q.w)
+        pose[:3, 3] = (p.x, p.y, p.z)
+        return pose
+
+    def _observe(self, tool: FloatArray) -> Observation:
+        with self._lock:
+            status = self._status
+            touched, released = self._touched, self._released
+            self._touched = self._released = False
+        wrench: tuple[float, ...] = (0.0,) * 6
+        active, message = True, ""
+        if status is not None:
+            f, t = status.wrench.force, status.wrench.torque
+            wrench = (f.x, f.y, f.z, t.x, t.y, t.z)
+            if status.header.stamp.to_sec() >= self._laws_at:  # it knows the step's laws
+                active, message = status.move_active, status.message
+        return Observation(rospy.get_time(), tool, wrench, active, message, touched, released)
+
+    # outputs
+
+    def _apply(self, run: TaskRun, command: Command, obs: Observation) -> Command:
+        ref = command.reference
+        if ref is not None:
+            msg = PathReference()
+            msg.header.stamp, msg.header.frame_id = rospy.Time.now(), self.fixed_frame
+            p, q, v = msg.pose.position, msg.pose.orientation, msg.velocity
+            p.x, p.y, p.z = ref.position
+            q.x, q.y, q.z, q.w = ref.quaternion
+            v.linear.x, v.linear.y, v.linear.z, v.angular.x, v.angular.y, v.angular.z = ref.twist
+            self._ref_pub.publish(msg)
+        if command.laws is not None:
+            req = ConfigureLawsRequest()
+            for axis in AXIS_NAMES:
+                given, law = getattr(command.laws, axis), getattr(req, axis)
+                for name in _LAW_FIELDS:
+                    setattr(law, name, getattr(given, name))
+            try:
+                answer = self._configure(req)
+                ok, why = answer.success, answer.message
+            except (rospy.ServiceException, rospy.ROSException) as err:
+                ok, why = False, f"configure_laws failed: {err}"
+            self._laws_at = rospy.get_time()
+            if not ok:
+                return self._apply(run, run.refused(why, obs), obs)
+        if command.stop:
+            try:
+                self._stop()
+            except (rospy.ServiceException, rospy.ROSException) as err:
+                rospy.logerr("task_server: could not stop contact_control's move: %s", err)
+        return command
+
+    # the action
+
+    def _load(self, goal: ExecuteTaskGoal) -> Task:
+        if goal.task_yaml:
+            return load_task(goal.task_yaml, "<goal task_yaml>")
+        if not goal.task or os.sep in goal.task or goal.task.startswith("."):
+            raise TaskError(f"task {goal.task!r}: give a task's name in {self.tasks_dir}, or task_yaml")
+        return load_task_file(os.path.join(self.tasks_dir, goal.task + ".yaml"))
+
+    def _execute(self, goal: ExecuteTaskGoal) -> None:
+        try:
+            task = self._load(goal)
+        except TaskError as err:
+            self._server.set_aborted(ExecuteTaskResult(outcome="refused", message=str(err)), str(err))
+            return
+        self._listen()
+        try:
+            self._carry_out(task)
+        finally:
+            self._unlisten()
+
+    def _carry_out(self, task: Task) -> None:
+        began = rospy.get_time()
+        with self._lock:
+            self._touched = self._released = False
+            self._not_before = began
+        status, tool = self._wait_for_inputs()
+        why = ""
+        if status is None:
+            why = (f"no ~status from {self._cc} within {self.s.status_timeout:g} s: is contact_control "
+                   "running?")
+        elif tool is None:
+            why = f"no transform {self.fixed_frame} -> {self.eef_frame}: the tool's pose is unknown"
+        if why or tool is None:
+            self._server.set_aborted(ExecuteTaskResult(outcome="refused", message=why), why)
+            return
+        self._laws_at = math.inf
+        run = TaskRun(task)
+        obs = self._observe(tool)
+        command = self._apply(run, run.start(obs), obs)
+        rate, every = rospy.Rate(self.s.rate), max(1, round(self.s.rate / self.s.feedback_rate))
+        feedback, cycle = ExecuteTaskFeedback(), 0
+        while run.running and not rospy.is_shutdown():
+            with self._lock:
+                self._running = f"task '{task.name}', step '{run.step_name}'"
+            rate.sleep()
+            tool = self._tool()
+            if tool is None:
+                lost = run.refused("the tool's pose is no longer available (tf)", obs)
+                command = self._apply(run, lost, obs)
+                break
+            obs = self._observe(tool)
+            if self._server.is_preempt_requested():
+                command = self._apply(run, run.cancel(obs), obs)
+                break
+            command = self._apply(run, run.update(obs), obs)
+            cycle += 1
+            if cycle % every == 0 and run.running:
+                feedback.step, feedback.elapsed = run.step_name, obs.t - began
+                w = feedback.wrench
+                w.force.x, w.force.y, w.force.z = obs.wrench[:3]
+                w.torque.x, w.torque.y, w.torque.z = obs.wrench[3:]
+                feedback.depth, feedback.search_radius = run.depth, run.search_radius
+                self._server.publish_feedback(feedback)
+        if run.running:  # shutting down
+            command = self._apply(run, run.cancel(obs), obs)
+        result = self._result(run)
+        with self._lock:
+            self._not_before = math.inf
+            self._running, self._last = "", f"last task '{task.name}': {result.outcome}: {result.message}"
+        rospy.loginfo("task_server: task '%s' %s: %s", task.name, result.outcome, result.message)
+        if command.outcome == SUCCEEDED:
+            self._server.set_succeeded(result, result.message)
+        elif command.outcome in (FAILED, RUNNING):
+            self._server.set_aborted(result, result.message)
+        else:
+            self._server.set_preempted(result, result.message)
+
+    def _result(self, run: TaskRun) -> ExecuteTaskResult:
+        r = run.result
+        result = ExecuteTaskResult(success=r.outcome == SUCCEEDED, outcome=r.outcome, message=r.reason)
+        result.steps = list(r.step_times)
+        result.step_times = [r.step_times[name] for name in result.steps]
+        result.peak_force, result.peak_torque = r.peak_force, r.peak_torque
+        if r.end_pose is not None:
+            pose = result.end_pose
+            pose.header.stamp, pose.header.frame_id = rospy.Time.now(), self.fixed_frame
+            p, o = pose.pose.position, pose.pose.orientation
+            p.x, p.y, p.z = (float(x) for x in r.end_pose[:3, 3])
+            o.x, o.y, o.z, o.w = matrix_quaternion(r.end_pose[:3, :3].tolist())
+        return result
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of `rosrun contact_tasks task_server`; 1 on a bad configuration."""
+    rospy.init_node("task_server", argv=list(sys.argv if argv is None else argv))
+    try:
+        s = load_settings(rospy.get_param("~", {}))
+    except TaskError as err:
+        rospy.logfatal("task_server: bad configuration, not starting: %s", err)
+        return 1
+    cc = rospy.resolve_name(s.contact_control_node) + "/"
+    fixed = str(rospy.get_param(cc + "fixed_frame", "base_link"))
+    eef = str(rospy.get_param(cc + "eef_frame", "tool0"))
+    tasks_dir = os.path.expanduser(s.tasks_dir) or os.path.join(rospkg.RosPack().get_path("contact_tasks"),
+                                                                "tasks")
+    TaskServer(s, fixed, eef, tasks_dir)
+    rospy.loginfo("task_server: tasks in %s, tool pose %s in %s", tasks_dir, eef, fixed)
+    rospy.spin()
+    return 0
