@@ -165,6 +165,18 @@ def test_limits_bound_velocity_and_force_ranges():
     assert err.value.code == SET_CONTROL_FORCE_FAILED
 
 
+def test_a_compliant_move_no_faster_than_the_min_velocity_is_refused():
+    """contact_control zeroes commands of at most min_velocity: such a move would never start."""
+    limits = RequestLimits(min_velocity=0.005, min_angular_velocity=0.005)
+    assert validate_request(_req("z", LAW_COMPLIANT_MOVE, v=-0.006, travel=0.1), limits)[2].velocity == -0.006
+    with pytest.raises(RequestError) as err:
+        validate_request(_req("z", LAW_COMPLIANT_MOVE, v=-0.005, travel=0.1), limits)
+    assert err.value.code == SET_CARTESIAN_CONTROL_FAILED
+    assert "desired velocity 0.005 is not above min_velocity_linear 0.005 m/s" in err.value.message
+    with pytest.raises(RequestError, match="min_velocity_angular"):
+        validate_request(_req("rz", LAW_COMPLIANT_MOVE, v=0.004, travel=0.1), limits)
+
+
 def test_malformed_objects_are_refused():
     with pytest.raises(RequestError) as err:
         validate_request(object())

@@ -124,6 +124,8 @@ class RequestLimits:
     max_torque: float | None = None  # [Nm]
     default_velocity: float | None = None  # [m/s]
     default_angular_velocity: float | None = None  # [rad/s]
+    min_velocity: float | None = None  # [m/s] a compliant move's |V_desired| must be above it (zeroed)
+    min_angular_velocity: float | None = None  # [rad/s]
 
     @classmethod
     def from_settings(cls, settings: ContactControlSettings) -> RequestLimits:
@@ -135,6 +137,8 @@ class RequestLimits:
             settings.global_max_torque,
             settings.compliant_default_velocity_linear,
             settings.compliant_default_velocity_angular,
+            settings.min_velocity_linear,
+            settings.min_velocity_angular,
         )
 
 
@@ -321,6 +325,12 @@ def _axis_law(
     if vmax is not None and abs(v) > vmax:
         raise fail(SET_CARTESIAN_CONTROL_FAILED, f"desired velocity exceeds max velocity {vmax} {unit_v}",
                    "v")
+    vmin = limits.min_angular_velocity if angular else limits.min_velocity
+    if vmin is not None and abs(v) <= vmin:
+        kind = "angular" if angular else "linear"
+        raise fail(SET_CARTESIAN_CONTROL_FAILED, f"desired velocity {abs(v):g} is not above "
+                   f"min_velocity_{kind} {vmin:g} {unit_v}: commands that slow are zeroed, the move would "
+                   "not start", "v")
     if travel == 0.0 and limit == 0.0:
         # It would run until something else stopped it: require at least one of its two end conditions.
         raise fail(
