@@ -97,6 +97,8 @@ class TaskLoop:
             r = command.reference
             self.ctrl.set_path_reference(r.position, r.quaternion, r.twist, self.t)
         if command.laws is not None:
+            if command.restart:
+                self.ctrl.stop("the next step")
             self.ctrl.set_laws(validate_laws_request(command.laws), self.pose, self.t)
         if command.stop:
             self.ctrl.stop("the task ended")

@@ -39,7 +39,7 @@ def test_a_hole_too_far_away_fails_the_search_with_its_reason_and_retracts():
     loop, end = insert((0.015, 0.0))
     assert end.outcome == FAILED
     assert end.reason == "in step 'search': the hole was not found within 6 mm (retract: retracted)"
-    assert list(loop.run.result.step_times) == ["approach", "search", "retract"]
+    assert list(loop.run.result.step_times) == ["approach", "touch", "search", "retract"]
     assert loop.pose[2, 3] >= 0.02  # backed off 20 mm and more from the plate
     assert loop.run.result.peak_force < 30.0
 

@@ -126,3 +126,14 @@ def test_a_file_that_is_not_yaml_or_not_there_is_refused_naming_it(tmp_path):
         load_task_file(tmp_path / "missing.yaml")
     with pytest.raises(TaskError, match=r"^x.yaml: the file: expected a mapping"):
         load_task("- 1", "x.yaml")
+
+
+def test_overrides_merge_over_the_file_key_by_key_and_are_checked_like_it():
+    text = yaml.safe_dump(GOOD)
+    task = load_task(text, "probe.yaml", "{surface: 0.05, steps: {rub: {pattern: {distance: 0.03}}}}")
+    assert task.surface == 0.05 and task.steps["rub"].pattern.distance == 0.03
+    assert task.steps["rub"].pattern.axis == "-x"  # the rest of the pattern kept
+    with pytest.raises(TaskError, match=r"^probe.yaml: steps.rub.pattern.distnce is not a parameter"):
+        load_task(text, "probe.yaml", "{steps: {rub: {pattern: {distnce: 0.03}}}}")
+    with pytest.raises(TaskError, match="the overrides must be a mapping"):
+        load_task(text, "probe.yaml", "[1]")

@@ -64,17 +64,15 @@ def test_unknown_pose_is_refused_with_the_known_names(stack):
 
 
 def _start_a_slow_contact_move() -> None:
-    """A compliant move slowly along -X (contact_control's ~status then says move_active): 2 mm/s for at most
-    60 mm, so it runs for 30 s. At 10 mm/s over 50 mm it ended after 5 s, before a node started on a loaded
-    machine asked its question (CI: the late node then rightly moved)."""
+    """A contact move that runs until it is stopped (contact_control's ~status then says move_active): a
+    follower on X, so the arm stands still unless pushed. A compliant move that ends on its travel ended
+    before a node started on a loaded machine asked its question (CI: the late node then rightly moved)."""
     import rospy
     from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
 
     req = ConfigureForceControlRequest()
-    req.direction_control_laws.x.type = 3  # compliant move
+    req.direction_control_laws.x.type = 1  # follower
     req.cart_impedance_params.damping.translational.x = 30.0
-    req.cart_impedance_params.max_cart_vel.set.linear.x = -0.002
-    req.cart_impedance_params.max_path_deviation.translation.x = 0.06
     assert rospy.ServiceProxy("/configure_cartesian_impedance", ConfigureForceControl)(req).success
 
 

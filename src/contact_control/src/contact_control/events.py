@@ -70,6 +70,9 @@ class EventWatch:
         if r.safety == SAFETY_OVER_LIMIT:
             if not self._over:
                 self._over = True
+                if not self.touching:  # a jump past the global limit passed the touch force unfiltered
+                    self.touching = True
+                    self._add(TOUCH, r, "touch: the contact force jumped over the global limit")
                 self._add(FORCE_LIMIT, r, r.message or "over the global force/torque limit")
         else:
             self._over = False

@@ -27,13 +27,13 @@ def _check(files: Sequence[str]) -> int:
     return 1 if bad else 0
 
 
-def _run(target: str, server: str, timeout: float) -> int:
+def _run(target: str, server: str, timeout: float, overrides: str) -> int:
     import actionlib
     import rospy
     from compliant_control_msgs.msg import ExecuteTaskAction, ExecuteTaskFeedback, ExecuteTaskGoal
 
     rospy.init_node("task_cli", anonymous=True, disable_signals=False)
-    goal = ExecuteTaskGoal()
+    goal = ExecuteTaskGoal(overrides=overrides)
     path = pathlib.Path(target)
     if path.suffix in (".yaml", ".yml") or path.exists():
         try:
@@ -82,7 +82,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     run.add_argument("task", help="a task's name in the server's tasks folder, or a task file")
     run.add_argument("--server", default="/task_server/execute", help="the ExecuteTask action")
     run.add_argument("--timeout", type=float, default=10.0, help="seconds to wait for the server")
+    run.add_argument("--set", default="", metavar="YAML", help="overrides merged over the task's keys, e.g. "
+                     "'{surface: 0.05}'")
     args = parser.parse_args(argv)
     if args.command == "check":
         return _check(args.files)
-    return _run(args.task, args.server, args.timeout)
+    return _run(args.task, args.server, args.timeout, args.set)

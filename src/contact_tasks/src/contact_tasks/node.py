@@ -159,6 +159,8 @@ class TaskServer:
             v.linear.x, v.linear.y, v.linear.z, v.angular.x, v.angular.y, v.angular.z = ref.twist
             self._ref_pub.publish(msg)
         if command.laws is not None:
+            if command.restart:
+                self._call_stop()
             req = ConfigureLawsRequest()
             for axis in AXIS_NAMES:
                 given, law = getattr(command.laws, axis), getattr(req, axis)
@@ -173,20 +175,23 @@ class TaskServer:
             if not ok:
                 return self._apply(run, run.refused(why, obs), obs)
         if command.stop:
-            try:
-                self._stop()
-            except (rospy.ServiceException, rospy.ROSException) as err:
-                rospy.logerr("task_server: could not stop contact_control's move: %s", err)
+            self._call_stop()
         return command
+
+    def _call_stop(self) -> None:
+        try:
+            self._stop()
+        except (rospy.ServiceException, rospy.ROSException) as err:
+            rospy.logerr("task_server: could not stop contact_control's move: %s", err)
 
     # the action
 
     def _load(self, goal: ExecuteTaskGoal) -> Task:
         if goal.task_yaml:
-            return load_task(goal.task_yaml, "<goal task_yaml>")
+            return load_task(goal.task_yaml, "<goal task_yaml>", goal.overrides)
         if not goal.task or os.sep in goal.task or goal.task.startswith("."):
             raise TaskError(f"task {goal.task!r}: give a task's name in {self.tasks_dir}, or task_yaml")
-        return load_task_file(os.path.join(self.tasks_dir, goal.task + ".yaml"))
+        return load_task_file(os.path.join(self.tasks_dir, goal.task + ".yaml"), goal.overrides)
 
     def _execute(self, goal: ExecuteTaskGoal) -> None:
         try:

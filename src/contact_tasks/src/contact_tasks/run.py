@@ -65,6 +65,8 @@ class Command:
 
     Attributes:
         laws: a ConfigureLaws-shaped request to send now (a step began; send `reference` first), or None.
+        restart: stop the running move before sending `laws`: contact_control carries an axis that keeps
+            its law type on from the running move (its travel too), and a step's travel counts from its start.
         reference: the path reference to publish now, or None (the step has no path law).
         stop: stop contact_control's move (the task ended).
         outcome: RUNNING, SUCCEEDED, FAILED or CANCELLED; reason: why it ended.
@@ -72,6 +74,7 @@ class Command:
 
     step: str
     laws: object | None = None
+    restart: bool = False
     reference: Reference | None = None
     stop: bool = False
     outcome: str = RUNNING
@@ -104,6 +107,7 @@ class TaskRun:
         self._start_pose = np.eye(4)
         self._frame = np.eye(3)
         self._touch: FloatArray | None = None
+        self._origin: FloatArray | None = None  # the tool's position at the task's start
         self._since: dict[int, float] = {}  # exit index -> when its threshold began to hold
         self._failing = ""  # the task's failure reason while its on-failure step runs
         sign = -1.0 if task.approach.startswith("-") else 1.0
@@ -116,6 +120,7 @@ class TaskRun:
 
     def start(self, obs: Observation) -> Command:
         """Begins the task's first step at `obs`."""
+        self._origin = obs.tool[:3, 3].copy()
         return self._begin(self.task.start, self.task.steps[self.task.start], obs)
 
     def update(self, obs: Observation) -> Command:
@@ -131,6 +136,8 @@ class TaskRun:
             self._touch = obs.tool[:3, 3].copy()
         if self._touch is not None:
             self.depth = float((obs.tool[:3, 3] - self._touch) @ self._approach)
+        elif self.task.surface is not None and self._origin is not None:
+            self.depth = float((obs.tool[:3, 3] - self._origin) @ self._approach) - self.task.surface
         task = self.task
         # The ceilings guard the task's own steps; the on-failure step backs off from a force that may still
         # be above them (its own force limit and contact_control's global limits guard it).
@@ -144,7 +151,7 @@ class TaskRun:
         self.search_radius = point.radius
         for i, ex in enumerate(self._step.exits):
             if self._holds(i, ex, obs, step_t, point):
-                return self._take(ex, obs)
+                return self._take(ex, obs, obs.move_message if ex.when == "move_ended" else "")
         return Command(self.step_name, reference=self._reference(point))
 
     def cancel(self, obs: Observation) -> Command:
@@ -159,6 +166,7 @@ class TaskRun:
     # steps
 
     def _begin(self, name: str, step: Step, obs: Observation) -> Command:
+        restart = self._step is not None and bool(self._step.laws)
         self._account(obs)
         self.step_name, self._step, self._step_t = name, step, obs.t
         self._start_pose = obs.tool.copy()
@@ -167,9 +175,10 @@ class TaskRun:
         self.search_radius = 0.0
         self.result.step_times.setdefault(name, 0.0)
         reference = self._reference(evaluate(step.pattern, 0.0)) if _has_path(step) else None
-        return Command(name, laws=laws_request(step.laws), reference=reference)
+        return Command(name, laws=laws_request(step.laws), restart=restart, reference=reference)
 
-    def _take(self, ex: Exit, obs: Observation) -> Command:
+    def _take(self, ex: Exit, obs: Observation, why: str) -> Command:
+        """Takes exit `ex`; `why`: contact_control's word on how the step's move ended (a failure says it)."""
         if ex.next:
             return self._begin(ex.next, self.task.steps[ex.next], obs)
         if self._failing:
@@ -177,7 +186,7 @@ class TaskRun:
             return self._end(FAILED, f"{self._failing} ({self.step_name}: {said})", obs)
         if ex.succeed:
             return self._end(SUCCEEDED, ex.succeed, obs)
-        return self._fail(f"in step '{self.step_name}': {ex.fail}", obs)
+        return self._fail(f"in step '{self.step_name}': {ex.fail}" + (f" ({why})" if why else ""), obs)
 
     def _fail(self, reason: str, obs: Observation) -> Command:
         """The task failed: its on-failure step (or the built-in retract) runs, then it ends FAILED."""

@@ -112,7 +112,9 @@ class Retract:
     distance: float = param(0.02, unit="m", gt=0.0, le=0.5, doc="how far back along the approach")
     speed: float = param(0.01, unit="m/s", gt=0.0, le=0.25, doc="how fast")
     damping: float = param(2000.0, unit="N/(m/s)", gt=0.0, doc="b of the move and of the followers")
-    force_limit: float = param(30.0, unit="N", gt=0.0, doc="|F| that stops the retract")
+    force_limit: float = param(20.0, unit="N", gt=0.0,
+                               doc="|F| that stops the retract (contact_control refuses one above its global "
+                               "limit)")
     timeout: float = param(10.0, unit="s", gt=0.0, doc="the retract ends after this long")
 
 
@@ -145,6 +147,7 @@ class Task:
     steps: dict[str, Step]
     start: str
     approach: str = "-z"
+    surface: float | None = None
     force_ceiling: float = 25.0
     torque_ceiling: float = 2.0
     on_failure: str = ""
@@ -159,6 +162,11 @@ class _TaskKeys:
     start: str = param("", doc="the first step (default: the first in `steps`)")
     approach: str = param("-z", choices=("x", "y", "z", "-x", "-y", "-z"), doc="the direction the tool moves "
                           "into the part, in contact_control's control frame (depth is measured along it)")
+    surface: float | None = param(
+        None, type="float", optional=True, ge=0.0, unit="m",
+        doc="the part's nominal surface this far along `approach` from the tool at the task's start: depth "
+        "counts from it until the first touch (a peg that meets the hole on its way in never touches)",
+    )
     force_ceiling: float = param(25.0, unit="N", gt=0.0, doc="|F| above this fails the task at once")
     torque_ceiling: float = param(2.0, unit="Nm", gt=0.0, doc="|T| above this fails the task at once")
     on_failure: str = param("", doc="a step run when the task fails (default: the built-in retract)")

@@ -34,7 +34,7 @@ from contact_tasks.task import (
     TaskError,
 )
 
-__all__ = ["laws_request", "load_task", "load_task_file", "parse_task"]
+__all__ = ["laws_request", "load_task", "load_task_file", "merged", "parse_task"]
 
 _LAW_CODES = {name: code for code, name in LAW_NAMES.items()}
 _ACTION_CODES = {name: code for code, name in EXCEEDED_ACTION_NAMES.items()}
@@ -49,8 +49,8 @@ _PATTERN_KEYS = {
 _THRESHOLD_EXITS = ("force", "travel", "depth")
 
 
-def load_task_file(path: str | pathlib.Path) -> Task:
-    """The task in a YAML file.
+def load_task_file(path: str | pathlib.Path, overrides: str = "") -> Task:
+    """The task in a YAML file (`overrides`: see `load_task`).
 
     Raises:
         TaskError: unreadable, not YAML, or not a valid task: "<file>: <key>: <why>".
@@ -60,16 +60,35 @@ def load_task_file(path: str | pathlib.Path) -> Task:
         text = path.read_text(encoding="utf-8")
     except OSError as err:
         raise TaskError(f"{path}: cannot read the task file: {err.strerror}") from None
-    return load_task(text, str(path))
+    return load_task(text, str(path), overrides)
 
 
-def load_task(text: str, source: str = "<task>") -> Task:
-    """The task in YAML `text`; `source` names it in errors (a file name, or "<goal>" for an inline one)."""
+def load_task(text: str, source: str = "<task>", overrides: str = "") -> Task:
+    """The task in YAML `text`; `source` names it in errors (a file name, or "<goal>" for an inline one).
+    `overrides`: a YAML mapping merged over it key by key before it is checked (`{surface: 0.05}`,
+    `{steps: {search: {pattern: {pitch: 0.001}}}}`)."""
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as err:
         raise TaskError(f"{source}: not YAML: {err}") from None
+    if overrides.strip():
+        try:
+            extra = yaml.safe_load(overrides)
+        except yaml.YAMLError as err:
+            raise TaskError(f"{source}: the overrides are not YAML: {err}") from None
+        if not isinstance(extra, Mapping) or not isinstance(data, Mapping):
+            raise TaskError(f"{source}: the overrides must be a mapping of the task's keys, got {extra!r}")
+        data = merged(data, extra)
     return parse_task(data, source)
+
+
+def merged(base: Mapping[str, object], extra: Mapping[str, object]) -> dict[str, object]:
+    """`base` with `extra` merged in: mappings key by key, anything else replaced."""
+    out = dict(base)
+    for key, value in extra.items():
+        old = out.get(key)
+        out[key] = merged(old, value) if isinstance(old, Mapping) and isinstance(value, Mapping) else value
+    return out
 
 
 def parse_task(data: object, source: str = "<task>") -> Task:
@@ -80,8 +99,8 @@ def parse_task(data: object, source: str = "<task>") -> Task:
         raise TaskError(f"{source}: {err}") from None
 
 
-class _RefusedError(Exception):
-    """One problem, with its key path (becomes the TaskError's message)."""
+class _RefusedError(TaskError):
+    """One problem, with its key path, before the file's name is put in front (`parse_task`)."""
 
 
 def _load(schema: Schema, data: object, where: str) -> dict[str, object]:
@@ -118,6 +137,7 @@ class _Parser:
             steps=steps,
             start=start,
             approach=str(keys.get("approach", "-z")),
+            surface=keys.get("surface"),  # type: ignore[arg-type]
             force_ceiling=float(keys.get("force_ceiling", 25.0)),  # type: ignore[arg-type]
             torque_ceiling=float(keys.get("torque_ceiling", 2.0)),  # type: ignore[arg-type]
             on_failure=str(keys.get("on_failure", "")),

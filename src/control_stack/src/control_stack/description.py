@@ -19,6 +19,7 @@ coincides with the sensor frame; the tool's shape extends along the sensor's +Z;
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import glob
 import os
 import shlex
@@ -407,6 +408,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--tool-size", type=float, nargs="+", default=[0.03, 0.1],
                         help="cylinder: radius length; box: x y z; sphere: radius [m]")
     parser.add_argument("--tip-name", default="tool_tip", help="frame link at the tool's end")
+    parser.add_argument("--tool-peg", type=float, default=0.0, metavar="WIDTH",
+                        help="make the tool a square peg this wide [m], same length, mass and centre of mass "
+                        "(contact_tasks' peg_in_hole; 0: the shape given)")
     return parser
 
 
@@ -425,6 +429,10 @@ def main(argv: Sequence[str] | None = None) -> int:
                 inertia=tuple(args.tool_inertia) if args.tool_inertia else None,
                 shape=args.tool_shape, size=tuple(args.tool_size), tip_name=args.tip_name,
             )
+            if args.tool_peg > 0.0:
+                width, length = args.tool_peg, tool.length()
+                tool = dataclasses.replace(tool, shape="box", size=(width, width, length),
+                                           com=tool.com or tool.centre())
         sys.stdout.write(build_description(text, tool, args.remove_link, erd_dir, args.robot_name))
     except DescriptionError as exc:
         sys.stderr.write(f"make_description: error: {exc}\n")

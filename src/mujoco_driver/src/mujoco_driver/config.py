@@ -149,6 +149,20 @@ class Box:
 
 
 @dataclass(frozen=True)
+class Hole:
+    """A plate with a square, chamfered hole lying on the obstacle block (mujoco_driver.fixtures): the peg's
+    width, the clearance, depth and chamfer [m], the plate's side [m], and the hole's offset from the block's
+    centre (dx, dy [m], yaw [rad]), which a task is not told."""
+
+    peg: float = 0.01
+    clearance: float = 0.0004
+    depth: float = 0.02
+    chamfer: float = 0.001
+    plate: float = 0.12
+    offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
 class ServoConfig:
     """Joint position servos (PD with velocity feed-forward, like an industrial joint controller).
 
@@ -197,6 +211,7 @@ class SceneConfig:
     obstacle: Box | None = None
     wrench_noise: NoiseConfig = field(default_factory=NoiseConfig)
     held_joints: Mapping[str, float] = field(default_factory=dict)
+    hole: Hole | None = None
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> SceneConfig:

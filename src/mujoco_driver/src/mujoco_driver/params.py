@@ -15,7 +15,8 @@ from typing import Any
 from compliant_common.errors import StackError
 from compliant_common.schema import Param, SchemaError, param, schema_of
 
-from mujoco_driver.config import PerJoint, SceneConfig, load_scene_config
+from mujoco_driver.config import Hole, PerJoint, SceneConfig, load_scene_config
+from mujoco_driver.fixtures import hole_offset
 
 __all__ = ["PARAMETERS", "DriverParamError", "DriverSettings", "load_scene", "urdf_root_link"]
 
@@ -75,6 +76,23 @@ class DriverSettings:
     eef_pose_period: float = param(
         0.01, unit="s", ge=0.0, doc="period of `~eef_pose` (ground truth for plots); 0 = with `joint_states`"
     )
+    fixture: str = param(
+        "none", choices=("none", "hole"),
+        doc="hole: a plate with a square, chamfered hole on the obstacle block, for a square peg tool "
+        "(README, Fixtures)",
+    )
+    hole_offset: tuple[float, ...] = param(
+        (0.0, 0.0, 0.0), type="floats", length=3, unit="m, m, rad",
+        doc="the hole's offset from the block's top centre (dx, dy, yaw), which a task is not told",
+    )
+    hole_seed: int = param(
+        -1, ge=-1, doc=">= 0: the offset drawn from this seed instead (within 4 mm and 2 degrees of nominal)"
+    )
+    hole_clearance: float = param(0.0004, unit="m", gt=0.0, le=0.01, doc="hole width minus the peg's")
+    hole_chamfer: float = param(0.001, unit="m", ge=0.0, le=0.005,
+                                doc="the hole's 45-degree chamfer (0: none)")
+    hole_depth: float = param(0.02, unit="m", gt=0.0, le=0.1, doc="the hole's depth")
+    peg_width: float = param(0.01, unit="m", gt=0.0, le=0.05, doc="the square peg's width (the tool's)")
     command_timeout: float = _pos(
         0.1, "s", "velocity watchdog: the velocity target goes back to zero this long after the last command"
     )
@@ -192,6 +210,11 @@ def urdf_root_link(urdf_xml: str) -> str:
     return str(roots[0])
 
 
+# contact_tasks' peg_in_hole demonstration: the hole within 4 mm and 2 degrees of its nominal pose (#35).
+HOLE_SPREAD = 0.004  # [m]
+HOLE_YAW_SPREAD = 0.035  # [rad]
+
+
 def load_scene(settings: DriverSettings) -> SceneConfig:
     """The scene settings from ``~scene_config`` or ``~scene``, with ``~start_pose`` applied.
 
@@ -206,4 +229,13 @@ def load_scene(settings: DriverSettings) -> SceneConfig:
         cfg = dataclasses.replace(cfg, start_pose=PerJoint.parse(settings.start_pose, "~start_pose"))
     if settings.timestep > 0.0:
         cfg = dataclasses.replace(cfg, timestep=settings.timestep)
+    if settings.fixture == "hole":
+        if cfg.obstacle is None:
+            raise DriverParamError("~fixture hole: the scene has no obstacle block to put the plate on")
+        offset = tuple(settings.hole_offset)
+        if settings.hole_seed >= 0:
+            offset = hole_offset(settings.hole_seed, HOLE_SPREAD, HOLE_YAW_SPREAD)
+        hole = Hole(peg=settings.peg_width, clearance=settings.hole_clearance, depth=settings.hole_depth,
+                    chamfer=settings.hole_chamfer, offset=offset)  # type: ignore[arg-type]
+        cfg = dataclasses.replace(cfg, hole=hole)
     return cfg

@@ -31,6 +31,7 @@ from compliant_common.errors import StackError
 from control_stack.description import DescriptionError, parse_robot
 
 from mujoco_driver.config import SceneConfig
+from mujoco_driver.fixtures import hole_boxes
 from mujoco_driver.meshes import LinkGeometry, prepare_collision
 
 __all__ = [
@@ -268,6 +269,11 @@ def _add_environment(spec: mujoco.MjSpec, cfg: SceneConfig) -> None:
         geom = world.add_geom(name="obstacle", type=mujoco.mjtGeom.mjGEOM_BOX, size=[s / 2 for s in obs.size],
                               pos=list(obs.position), quat=rpy_to_quat(obs.rpy), rgba=[0.8, 0.2, 0.2, 1.0])
         geom.solimp = OBSTACLE_SOLIMP
+        if cfg.hole is not None:
+            for box in hole_boxes(obs, cfg.hole):
+                part = world.add_geom(name=box.name, type=mujoco.mjtGeom.mjGEOM_BOX, size=list(box.half),
+                                      pos=list(box.pos), quat=list(box.quat), rgba=[0.7, 0.7, 0.75, 1.0])
+                part.solimp = OBSTACLE_SOLIMP
 
 
 OVERLAP_SAMPLES = 8  # postures (the start pose and fixed pseudo-random ones) a pair must touch in all of

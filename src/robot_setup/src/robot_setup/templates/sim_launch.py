@@ -29,6 +29,10 @@ def sim_launch(plan: Plan) -> str:
   <arg name="with_contact_control" default="true" doc="start contact_control_node"/>
   <arg name="single_process" default="true" doc="contact_control and jog_arm in one process (control_stack_node), one hop less"/>
   <arg name="publish_synchronously" default="true" doc="the driver writes subscribers' sockets in its loop"/>
+  <arg name="fixture" default="none" doc="hole: a plate with a square, chamfered hole on the block (mujoco_driver README, Fixtures)"/>
+  <arg name="hole_offset" default="[0.0, 0.0, 0.0]" doc="the hole's offset from its nominal pose '[dx, dy, yaw]' [m, m, rad]"/>
+  <arg name="hole_seed" default="-1" doc="&gt;= 0: the hole's offset drawn from this seed instead (within 4 mm and 2 degrees)"/>
+  <arg name="tool" default="default" doc="peg: the tool becomes a 10 mm square peg of the same length and mass"/>
   <arg name="output" default="screen" doc="screen or log"/>
 
   <include file="$(find mujoco_driver)/launch/sim_stack.launch">
@@ -46,6 +50,10 @@ def sim_launch(plan: Plan) -> str:
     <arg name="with_contact_control" value="$(arg with_contact_control)"/>
     <arg name="single_process" value="$(arg single_process)"/>
     <arg name="publish_synchronously" value="$(arg publish_synchronously)"/>
+    <arg name="fixture" value="$(arg fixture)"/>
+    <arg name="hole_offset" value="$(arg hole_offset)"/>
+    <arg name="hole_seed" value="$(arg hole_seed)"/>
+    <arg name="tool" value="$(arg tool)"/>
     <arg name="output" value="$(arg output)"/>
   </include>
 

@@ -1,0 +1,96 @@
+"""Fixtures on the obstacle block: a plate with a square, chamfered hole, built from boxes (MuJoCo collides
+meshes by their convex hull, which would fill the hole). No MuJoCo here: the boxes are data that
+`scene._add_environment` turns into geoms, so the geometry is tested on its own (README, Fixtures).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from mujoco_driver.config import Box, Hole
+
+__all__ = ["FixtureBox", "hole_boxes", "hole_offset"]
+
+
+@dataclass(frozen=True)
+class FixtureBox:
+    """A box geom in the world: name, half extents [m], centre [m], orientation quaternion (w, x, y, z)."""
+
+    name: str
+    half: tuple[float, float, float]
+    pos: tuple[float, float, float]
+    quat: tuple[float, float, float, float]
+
+
+def hole_offset(seed: int, spread: float, yaw_spread: float) -> tuple[float, float, float]:
+    """A pseudo-random offset of the hole from its nominal pose: (dx, dy) uniform in a disc of radius
+    `spread` [m], yaw uniform in +-`yaw_spread` [rad]; the same for the same seed."""
+    rng = np.random.default_rng(seed)
+    radius, angle = spread * math.sqrt(float(rng.random())), 2.0 * math.pi * float(rng.random())
+    yaw = yaw_spread * (2.0 * float(rng.random()) - 1.0)
+    return (radius * math.cos(angle), radius * math.sin(angle), yaw)
+
+
+# name, half extents, centre, the axis a chamfer box is turned about ('' for none)
+_Part = tuple[str, tuple[float, float, float], tuple[float, float, float], str]
+
+
+def _ring(name: str, a: float, plate: float, z0: float, z1: float) -> list[_Part]:
+    """Four boxes filling a square plate of half side `plate` around a square opening of half side `a`,
+    between heights z0 < z1 (hole frame)."""
+    t, zc, w = (z1 - z0) / 2.0, (z0 + z1) / 2.0, (plate - a) / 2.0
+    c = (a + plate) / 2.0
+    return [
+        (f"{name}_east", (w, plate, t), (c, 0.0, zc), ""),
+        (f"{name}_west", (w, plate, t), (-c, 0.0, zc), ""),
+        (f"{name}_north", (a, w, t), (0.0, c, zc), ""),
+        (f"{name}_south", (a, w, t), (0.0, -c, zc), ""),
+    ]
+
+
+def hole_boxes(block: Box, hole: Hole) -> list[FixtureBox]:
+    """The plate lying on the block's top, its hole at the top's centre moved by `hole.offset`.
+
+    The hole's bottom is the block's top; its opening is `peg + clearance` wide and widens by `chamfer` on
+    each side at the top, the 45-degree chamfer made of boxes turned about the edges.
+    """
+    if any(abs(a) > 1e-9 for a in block.rpy[:2]):
+        raise ValueError("the hole fixture needs a level obstacle (rpy roll and pitch 0)")
+    half_hole, chamfer, depth = (hole.peg + hole.clearance) / 2.0, hole.chamfer, hole.depth
+    plate = hole.plate / 2.0
+    parts = _ring("hole_plate", half_hole, plate, -depth, -chamfer if chamfer > 0.0 else 0.0)
+    if chamfer > 0.0:
+        parts += _ring("hole_rim", half_hole + chamfer, plate, -chamfer, 0.0)
+        edge, side = half_hole + chamfer, chamfer / math.sqrt(2.0)
+        parts += [  # squares turned 45 degrees: one face is the chamfer, the rest lies inside the plate
+            ("hole_chamfer_east", (side, edge, side), (edge, 0.0, -chamfer), "y"),
+            ("hole_chamfer_west", (side, edge, side), (-edge, 0.0, -chamfer), "y"),
+            ("hole_chamfer_north", (edge, side, side), (0.0, edge, -chamfer), "x"),
+            ("hole_chamfer_south", (edge, side, side), (0.0, -edge, -chamfer), "x"),
+        ]
+    dx, dy, dyaw = hole.offset
+    yaw = block.rpy[2] + dyaw
+    c, s = math.cos(yaw), math.sin(yaw)
+    top = block.position[2] + block.size[2] / 2.0 + depth
+    origin = np.array([block.position[0] + dx, block.position[1] + dy, top])
+    turn = (math.cos(yaw / 2.0), 0.0, 0.0, math.sin(yaw / 2.0))
+    boxes = []
+    q = math.cos(math.pi / 8.0), math.sin(math.pi / 8.0)
+    for name, half, local, axis in parts:
+        pos = origin + np.array([c * local[0] - s * local[1], s * local[0] + c * local[1], local[2]])
+        quat = turn
+        if axis:  # 45 degrees about the hole frame's x or y axis, then the yaw
+            quat = _multiply(turn, (q[0], q[1], 0.0, 0.0) if axis == "x" else (q[0], 0.0, q[1], 0.0))
+        boxes.append(FixtureBox(name, half, (float(pos[0]), float(pos[1]), float(pos[2])), quat))
+    return boxes
+
+
+def _multiply(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, float, float, float]:
+    """Quaternion product a b, (w, x, y, z)."""
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return (w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2)

@@ -1,0 +1,65 @@
+"""The hole fixture (mujoco_driver.fixtures): a 10 mm square peg fits its 10.4 mm hole, touches a wall past
+the clearance, rests on the 45-degree chamfer at the right depth, and stands on the plate elsewhere."""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import pytest
+from mujoco_driver.fixtures import hole_boxes, hole_offset
+
+from mujoco_driver.config import Box, Hole
+
+BLOCK = Box(position=(0.6, 0.1, 0.065), size=(0.15, 0.15, 0.13), rpy=(0.0, 0.0, 0.3))
+HOLE = Hole(offset=(0.003, -0.002, 0.02))
+TOP = 0.13 + HOLE.depth  # the plate's top [m]
+YAW = 0.3 + 0.02
+
+
+def touches(x: float, y: float, bottom: float) -> bool:
+    """Whether the peg (10 mm square, 40 mm long, turned like the hole) with its bottom face at `bottom`,
+    centred at (x, y) in the hole's own axes from its centre, touches the fixture."""
+    spec = mujoco.MjSpec()
+    for box in hole_boxes(BLOCK, HOLE):
+        spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=list(box.half), pos=list(box.pos),
+                                quat=list(box.quat))
+    c, s = math.cos(YAW), math.sin(YAW)
+    centre = (0.6 + 0.003 + c * x - s * y, 0.1 - 0.002 + s * x + c * y, bottom + 0.02)
+    peg = spec.worldbody.add_body(pos=list(centre), quat=[math.cos(YAW / 2), 0.0, 0.0, math.sin(YAW / 2)])
+    peg.add_freejoint()
+    peg.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.005, 0.005, 0.02])
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    return any(data.contact[i].dist < 0.0 for i in range(data.ncon))
+
+
+def test_the_peg_fits_the_hole_within_its_clearance_and_touches_a_wall_beyond_it():
+    assert not touches(0.0, 0.0, TOP - 0.015)
+    assert not touches(0.00015, -0.00015, TOP - 0.015)  # within the 0.2 mm either side
+    assert touches(0.0003, 0.0, TOP - 0.015)
+    assert touches(0.0, -0.0003, TOP - 0.015)
+
+
+def test_the_peg_rests_on_the_chamfer_at_its_depth_and_on_the_plate_beyond_it():
+    # 0.8 mm off centre the peg's edge is 5.8 mm out, over the chamfer, whose surface there is 0.4 mm down.
+    assert not touches(0.0008, 0.0, TOP - 0.0003)
+    assert touches(0.0008, 0.0, TOP - 0.0005)
+    assert not touches(0.0, 0.0008, TOP - 0.0003)
+    assert touches(0.0, 0.0008, TOP - 0.0005)
+    # 2 mm off it stands on the plate's top.
+    assert not touches(0.002, 0.0, TOP + 0.0001)
+    assert touches(0.002, 0.0, TOP - 0.0001)
+
+
+def test_the_seeded_offset_is_within_its_spread_and_the_same_for_the_same_seed():
+    offsets = [hole_offset(seed, 0.004, 0.035) for seed in range(200)]
+    assert all(math.hypot(dx, dy) <= 0.004 and abs(yaw) <= 0.035 for dx, dy, yaw in offsets)
+    assert max(math.hypot(dx, dy) for dx, dy, _ in offsets) > 0.0035  # the disc's edge is reached
+    assert hole_offset(7, 0.004, 0.035) == offsets[7]
+
+
+def test_a_tilted_block_is_refused():
+    with pytest.raises(ValueError, match="level obstacle"):
+        hole_boxes(Box(position=(0.0, 0.0, 0.0), size=(0.1, 0.1, 0.1), rpy=(0.1, 0.0, 0.0)), HOLE)
