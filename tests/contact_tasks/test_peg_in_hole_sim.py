@@ -10,13 +10,11 @@ import pytest
 
 pytest.importorskip("compliant_control_msgs.msg", reason="needs devel/setup.bash (make test sources it)")
 
-import actionlib
 import numpy as np
-import tf2_ros
-from compliant_control_msgs.msg import ExecuteTaskAction, ExecuteTaskGoal
+from compliant_control_msgs.msg import ExecuteTaskGoal
 from compliant_control_msgs.srv import MoveToNamedPose
-from harness.launch import run_launch
-from harness.waiting import wait_until
+
+from .task_stack import task_stack
 
 BLOCK = (0.60, 0.109, 0.13)  # ur5_custom/config/sim.yaml: the block's top centre [m]
 PLATE_TOP = BLOCK[2] + 0.02  # the hole fixture's plate (hole_depth)
@@ -25,23 +23,17 @@ SURFACE = 0.05  # the start pose's tool tip (z 0.20) above the plate
 
 def insert(rospy, offset: tuple[float, float, float]):
     args = {"fixture": "hole", "tool": "peg", "hole_offset": f"[{offset[0]}, {offset[1]}, {offset[2]}]"}
-    with run_launch("ur5_custom", "sim.launch", args) as h:
-        h.wait_for_service("/named_poses/move_to", timeout=40)
-        client = actionlib.SimpleActionClient("/task_server/execute", ExecuteTaskAction)
-        assert client.wait_for_server(rospy.Duration(30.0))
-        buffer = tf2_ros.Buffer()
-        listener = tf2_ros.TransformListener(buffer)  # noqa: F841 (fills the buffer)
-        wait_until(lambda: buffer.can_transform("base_link", "tool_tip", rospy.Time(0)), 20, "the tool's tf")
+    with task_stack(args) as (h, client, tool):
         assert rospy.ServiceProxy("/named_poses/move_to", MoveToNamedPose)(name="start").success
         client.send_goal(ExecuteTaskGoal(task="peg_in_hole", overrides=f"{{surface: {SURFACE}}}"))
         assert client.wait_for_result(rospy.Duration(120.0))
         result = client.get_result()
-        p = buffer.lookup_transform("base_link", "tool_tip", rospy.Time(0)).transform.translation
+        tip = tool()
         h.stop()
     times = ", ".join(f"{n} {t:.1f} s" for n, t in zip(result.steps, result.step_times, strict=True))
     print(f"\npeg_in_hole, hole offset {offset}: {result.outcome}: {result.message}; {times}; "
           f"peak |F| {result.peak_force:.1f} N, |T| {result.peak_torque:.2f} Nm")
-    return result, np.array([p.x, p.y, p.z])
+    return result, tip
 
 
 def test_the_peg_goes_into_a_hole_off_its_nominal_pose(ros_node):

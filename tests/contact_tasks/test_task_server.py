@@ -11,11 +11,11 @@ pytest.importorskip("compliant_control_msgs.msg", reason="needs devel/setup.bash
 
 import actionlib
 import numpy as np
-import tf2_ros
-from compliant_control_msgs.msg import ContactControlStatus, ExecuteTaskAction, ExecuteTaskGoal
+from compliant_control_msgs.msg import ContactControlStatus, ExecuteTaskGoal
 from compliant_control_msgs.srv import MoveToNamedPose
-from harness.launch import run_launch
 from harness.waiting import wait_until
+
+from .task_stack import task_stack
 
 RUB = """
 task: rub
@@ -46,18 +46,7 @@ steps:
 
 def test_a_task_touches_rubs_at_a_force_and_cancels_and_refuses(ros_node):
     rospy = ros_node
-    with run_launch("ur5_custom", "sim.launch") as h:
-        h.wait_for_service("/named_poses/move_to", timeout=40)
-        client = actionlib.SimpleActionClient("/task_server/execute", ExecuteTaskAction)
-        assert client.wait_for_server(rospy.Duration(30.0))
-        buffer = tf2_ros.Buffer()
-        listener = tf2_ros.TransformListener(buffer)  # noqa: F841 (fills the buffer)
-        wait_until(lambda: buffer.can_transform("base_link", "tool_tip", rospy.Time(0)), 20, "the tool's tf")
-
-        def tool() -> np.ndarray:
-            p = buffer.lookup_transform("base_link", "tool_tip", rospy.Time(0)).transform.translation
-            return np.array([p.x, p.y, p.z])
-
+    with task_stack() as (h, client, tool):
         move = rospy.ServiceProxy("/named_poses/move_to", MoveToNamedPose)
         assert move(name="start").success
         start = tool()

@@ -32,6 +32,7 @@ def sim_launch(plan: Plan) -> str:
   <arg name="fixture" default="none" doc="hole: a plate with a square, chamfered hole on the block (mujoco_driver README, Fixtures)"/>
   <arg name="hole_offset" default="[0.0, 0.0, 0.0]" doc="the hole's offset from its nominal pose '[dx, dy, yaw]' [m, m, rad]"/>
   <arg name="hole_seed" default="-1" doc="&gt;= 0: the hole's offset drawn from this seed instead (within 4 mm and 2 degrees)"/>
+  <arg name="hole_clearance" default="0.0004" doc="[m] the hole's width minus the peg's"/>
   <arg name="tool" default="default" doc="peg: the tool becomes a 10 mm square peg of the same length and mass"/>
   <arg name="output" default="screen" doc="screen or log"/>
 
@@ -53,6 +54,7 @@ def sim_launch(plan: Plan) -> str:
     <arg name="fixture" value="$(arg fixture)"/>
     <arg name="hole_offset" value="$(arg hole_offset)"/>
     <arg name="hole_seed" value="$(arg hole_seed)"/>
+    <arg name="hole_clearance" value="$(arg hole_clearance)"/>
     <arg name="tool" value="$(arg tool)"/>
     <arg name="output" value="$(arg output)"/>
   </include>
