@@ -29,11 +29,10 @@ def test_the_survey_finds_the_arms_and_tells_why_the_rest_are_not_arms():
     assert "tiago_description/robots/tiago.urdf" in others  # an arm inside a robot: BASE= (tiago_custom)
 
 
-@pytest.mark.timeout(1800)  # its own: nine minutes of one core, only when the suite leaves a core idle
+@pytest.mark.alone  # after the rest (make test): beside them, even idle-scheduled, it slowed the sims
+@pytest.mark.timeout(1800)  # its own: nine minutes of one core
 def test_make_robot_and_make_check_robot_on_every_arm_of_the_library():
-    """Under SCHED_IDLE (chrt --idle), on two processes: minutes of pure computation must not delay the
-    simulations other tests run beside it on a two-core machine (a nice 19 process still holds a core until
-    the scheduler preempts it on their every wake-up), and use both cores when they are idle."""
+    """On two processes (both cores), under SCHED_IDLE (chrt --idle) should it run beside anything."""
     command = ["chrt", "--idle", "0", sys.executable, str(ROOT / "scripts" / "try_all_arms"), "--no-demo",
                "--jobs", "2"]
     run = subprocess.run(command, capture_output=True, text=True, timeout=1700, check=False)
