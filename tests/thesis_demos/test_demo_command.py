@@ -7,6 +7,7 @@ import re
 import subprocess
 
 import numpy as np
+import pytest
 from harness.bags import read_bag
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -52,6 +53,9 @@ def test_driver_options_without_a_driver_are_refused_before_anything_launches(tm
     assert not (tmp_path / "launch.log").exists()
 
 
+# Alone (after the parallel suite): beside another worker's simulations the UR3's pressed replay left
+# 10 +- 1.5 N (50 ms means 8.15..11.78 N, docs/measurements.md); the timing cause is not found yet (#36).
+@pytest.mark.alone
 def test_teach_and_replay_on_a_generated_arm(tmp_path):
     """The sixth demonstration as `make demo ROBOT=ur3` runs it: the L taught by the simulated hand is
     replayed in free space within 2 mm RMS / 5 mm max at 1 x and 2 x, and pressing on the block within
