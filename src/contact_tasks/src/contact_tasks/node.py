@@ -65,7 +65,7 @@ class TaskServer:
         self._not_before = math.inf  # events from before the task are ignored
         self._laws_at = math.inf
         self._subs: list[rospy.Subscriber] = []
-        self._running = ""  # "task 'name', step 'step'" while one runs
+        self._run: TaskRun | None = None  # the task running, for /diagnostics
         self._last = "idle"
         self._server = actionlib.SimpleActionServer("~execute", ExecuteTaskAction, self._execute,
                                                     auto_start=False)
@@ -77,7 +77,8 @@ class TaskServer:
         answer, so the level stays OK."""
         report = Report(rospy.get_name())
         with self._lock:
-            report.check(OK, self._running or self._last)
+            run = self._run
+            report.check(OK, f"task '{run.task.name}', step '{run.step_name}'" if run else self._last)
         report.value("tasks_dir", self.tasks_dir)
         return report
 
@@ -226,9 +227,9 @@ class TaskServer:
         command = self._apply(run, run.start(obs), obs)
         rate, every = rospy.Rate(self.s.rate), max(1, round(self.s.rate / self.s.feedback_rate))
         feedback, cycle = ExecuteTaskFeedback(), 0
+        with self._lock:
+            self._run = run
         while run.running and not rospy.is_shutdown():
-            with self._lock:
-                self._running = f"task '{task.name}', step '{run.step_name}'"
             rate.sleep()
             tool = self._tool()
             if tool is None:
@@ -253,7 +254,7 @@ class TaskServer:
         result = self._result(run)
         with self._lock:
             self._not_before = math.inf
-            self._running, self._last = "", f"last task '{task.name}': {result.outcome}: {result.message}"
+            self._run, self._last = None, f"last task '{task.name}': {result.outcome}: {result.message}"
         rospy.loginfo("task_server: task '%s' %s: %s", task.name, result.outcome, result.message)
         if command.outcome == SUCCEEDED:
             self._server.set_succeeded(result, result.message)

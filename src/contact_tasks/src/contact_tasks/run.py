@@ -131,7 +131,6 @@ class TaskRun:
         torque = math.sqrt(sum(f * f for f in obs.wrench[3:]))
         self.result.peak_force = max(self.result.peak_force, force)
         self.result.peak_torque = max(self.result.peak_torque, torque)
-        self.result.step_times[self.step_name] = self.result.step_times.get(self.step_name, 0.0)
         if obs.touched and self._touch is None:
             self._touch = obs.tool[:3, 3].copy()
         if self._touch is not None:
