@@ -7,6 +7,8 @@ the Panda the two-node layout (jog_arm reads contact_control's ~contact_wrench t
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 
@@ -15,6 +17,7 @@ pytest.importorskip("compliant_control_msgs.msg", reason="needs devel/setup.bash
 from compliant_control_msgs.msg import JogStatus
 from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
 from harness.launch import run_launch
+from harness.process import node_pid, stalled
 from harness.waiting import Collector, wait_until
 
 BASE_FRAME = {"ur5_custom": "base_link", "panda_custom": "panda_link0"}
@@ -118,3 +121,67 @@ def test_jogging_into_the_block_stops_under_the_guard_force_and_backing_out_work
                 c.close()
             pub.unregister()
         h.stop()
+
+
+@pytest.mark.parametrize("robot, single_process, stalled_node", [
+    ("panda_custom", False, "/contact_control_node"), ("ur5_custom", True, "/control_stack")])
+def test_a_stalled_controller_pauses_the_simulation_instead_of_letting_the_jog_press_on(ros_node, robot,
+                                                                                        single_process,
+                                                                                        stalled_node):
+    """The controller stops for 0.5 s (SIGSTOP, as a busy machine deschedules it) while jogging into the
+    block: two nodes, contact_control stops and jog_arm goes on jogging on the last force it heard; one
+    process, the commands stop and the driver holds the last one. The driver's lockstep holds the simulated
+    arm until the stack answers again (README of mujoco_driver, Lockstep), so the guard still stops the press
+    at its force; without it the press goes on at the slow-zone speed (44 N and 72 N measured)."""
+    rospy = ros_node
+    with run_launch(robot, "sim.launch", args={"single_process": str(single_process).lower()}) as h:
+        for topic in ("/mujoco_driver/eef_pose", "/wrench", "/jog_arm_server/status"):
+            h.wait_for_topic(topic, timeout=40)
+        h.wait_for_service("/contact_control_node/tare", timeout=40)
+        wrench = Collector("/wrench", WrenchStamped)
+        status = Collector("/jog_arm_server/status", JogStatus)
+        pub = rospy.Publisher("/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1, tcp_nodelay=True)
+        try:
+            wrench.wait_for(1, timeout=20)
+            status.wait_for(1, timeout=20)
+            wait_until(lambda: pub.get_num_connections() > 0, 10, "jog_arm to subscribe to its input")
+            weight = _force(wrench.last())
+            twist = TwistStamped()
+            twist.header.frame_id = BASE_FRAME[robot]
+            twist.twist.linear.z = -JOG_SPEED
+            rate = rospy.Rate(100)  # the sender's rate, like key_to_twist's repeat
+
+            def jog_while(condition, what: str, deadline: float = 20.0) -> None:
+                start = rospy.get_time()
+                while condition():
+                    assert h.proc.poll() is None, h.output()[-3000:]
+                    assert rospy.get_time() - start < deadline, f"timed out: {what}"
+                    twist.header.stamp = rospy.Time.now()
+                    pub.publish(twist)
+                    rate.sleep()  # the sender's rate, not a wait for a result
+
+            def contact() -> float:
+                return float(np.linalg.norm(_force(wrench.last()) - weight))
+
+            jog_while(lambda: contact() < 8.0, "the touch")
+            with stalled(node_pid(stalled_node)) as t0:
+                jog_while(lambda: time.monotonic() - t0 < 0.5, "the stall", deadline=5.0)
+            jog_while(lambda: status.last().code != JogStatus.CONTACT_GUARD, "the guard to act")
+            stopped = rospy.Time.now()
+            jog_while(lambda: rospy.get_time() - stopped.to_sec() < 0.5, "the key held after the guard")
+            wait_until(lambda: wrench.last().header.stamp >= rospy.Time.now() - rospy.Duration(0.1), 10,
+                       "the wrenches to catch up")
+            peak = max(float(np.linalg.norm(_force(m) - weight)) for m in list(wrench.msgs))
+            print(f"\n{robot}: {stalled_node} stalled 0.5 s while jogging into the block: peak {peak:.2f} N")
+            assert peak <= GUARD_FORCE + 2.0, peak
+            assert "lockstep: no" not in h.output()  # paused, never given up on in 0.5 s
+        finally:
+            wrench.close()
+            status.close()
+            pub.unregister()
+        h.stop()
+
+
+def _force(msg: WrenchStamped) -> np.ndarray:
+    f = msg.wrench.force
+    return np.array([f.x, f.y, f.z])

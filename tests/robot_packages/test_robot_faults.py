@@ -9,7 +9,6 @@ import os
 import signal
 import subprocess
 import time
-import xmlrpc.client
 
 import numpy as np
 import pytest
@@ -23,6 +22,7 @@ from compliant_control_msgs.msg import ContactControlStatus, JogStatus
 from compliant_control_msgs.srv import PushEEF, PushEEFRequest
 from geometry_msgs.msg import PoseStamped
 from harness.launch import run_launch
+from harness.process import node_pid
 from harness.ros_env import start_master
 from harness.waiting import Collector, wait_until
 from sensor_msgs.msg import JointState
@@ -112,13 +112,6 @@ def test_the_arm_stops_within_5_mm_when_the_command_source_is_killed_or_hangs(ro
             joints.close()
 
 
-def _node_pid(name: str) -> int:
-    master = xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"])
-    code, _, uri = master.lookupNode("/probe", name)
-    assert code == 1, name
-    return xmlrpc.client.ServerProxy(uri).getPid("/probe")[2]
-
-
 def test_jog_arm_stops_commanding_when_the_driver_hangs_mid_jog(ros_node):
     """The driver freezes (SIGSTOP: its joint states stop, its connections stay). A crash is not tried here:
     sim.launch marks the driver required, so roslaunch then stops the whole stack; on a real cell the
@@ -132,7 +125,7 @@ def test_jog_arm_stops_commanding_when_the_driver_hangs_mid_jog(ros_node):
             pose.wait_for(1, 20)
             with _readme_jog("ur5_custom"):
                 _wait_for_travel(pose, 0.02)
-                driver = _node_pid("/mujoco_driver")
+                driver = node_pid("/mujoco_driver")
                 os.kill(driver, signal.SIGSTOP)
                 killed = time.monotonic()
                 commands.clear()

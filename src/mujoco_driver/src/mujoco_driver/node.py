@@ -13,6 +13,7 @@ import faulthandler
 import math
 import os
 import signal
+import struct
 import sys
 import threading
 import time
@@ -39,6 +40,7 @@ from mujoco_driver.config import ConfigError, SceneConfig
 from mujoco_driver.emulated_driver import EmulatedDriver, resolve_profile
 from mujoco_driver.health import driver_health
 from mujoco_driver.latency import LatencyProbe
+from mujoco_driver.lockstep import Lockstep
 from mujoco_driver.pacing import Pacer, RtfMeter, TrailingPublication
 from mujoco_driver.params import DriverParamError, DriverSettings, load_scene, urdf_root_link
 from mujoco_driver.profiles import DriverProfile, ProfileError
@@ -55,6 +57,8 @@ _MAX_STAMP_AHEAD = 1.0  # [s] stamps further in the future too
 # loaded 2-core machine, and skipping those states costs the stack's controllers a cycle each (and moves
 # contact_control's measured wrench rate, so its filter design, between ~0.9 and 1 kHz).
 _CATCH_UP_LAG = 0.002
+_STAMP = struct.Struct("<II")  # a std_msgs/Header's stamp after its uint32 seq
+_LOCKSTEP_SLICE = 0.005  # [s] a lockstep wait wakes this often to publish and to see a stop
 
 
 class MujocoDriverNode:
@@ -119,6 +123,7 @@ class MujocoDriverNode:
         self._stamp = rospy.Time()
         self._state_stamp = rospy.Time()  # the pending joint state's (the shared one moves with /clock)
         self._latency = LatencyProbe(horizon=s.command_timeout)
+        self._lockstep = Lockstep(s.lockstep_lead) if s.lockstep_lead > 0.0 else None
         self._latency_msg = Float64MultiArray()
         self._latency_msg.layout.dim = [MultiArrayDimension("command", 0, 0),
                                         MultiArrayDimension("received_wall_time_and_latency", 2, 2)]
@@ -159,6 +164,10 @@ class MujocoDriverNode:
             self._subs = self._driver.subscribe_commands(self._on_trajectory, self._on_velocity)
         self._subs.append(rospy.Subscriber("~push_wrench", WrenchStamped, self._on_push_wrench, queue_size=1,
                                            tcp_nodelay=True))
+        if self._lockstep is not None and s.lockstep_echo_topic:
+            # Raw bytes: only the header's stamp is read, whatever the type (no deserialisation).
+            self._subs.append(rospy.Subscriber(s.lockstep_echo_topic, rospy.AnyMsg, self._on_echo,
+                                               queue_size=1, tcp_nodelay=True))
         self._services = [
             rospy.Service("~push", PushEEF, self._on_push),
             rospy.Service("~reset", Trigger, self._on_reset),
@@ -198,11 +207,31 @@ class MujocoDriverNode:
         state = TrailingPublication(s.joint_states_phase * pacer.period * self._publish_every)
         pacer.start(time.monotonic())
         self._read_state()
+        lockstep, waiting_since, current = self._lockstep, math.nan, True  # current: this state went out
         while not (self._stop_requested or rospy.is_shutdown()):
             now = time.monotonic()
             if state.due(now):
                 self._publish_state()
                 continue
+            if lockstep is not None:
+                why = lockstep.hold(sim.time)
+                if why:
+                    if not current:  # skipped while catching up: the stack needs it to answer
+                        current = True
+                        self._publish_current()
+                        continue
+                    if math.isnan(waiting_since):
+                        waiting_since = now
+                    if now - waiting_since < s.lockstep_wait:
+                        lockstep.wait(sim.time, state.sleep_time(now, _LOCKSTEP_SLICE))
+                        continue
+                    lockstep.give_up()
+                    rospy.logwarn("mujoco_driver: lockstep: no %s for %.2f s (wall time): running on; "
+                                  "command_timeout stops the arm", why, now - waiting_since)
+                if not math.isnan(waiting_since):  # a pause is not a backlog: no catching up after it
+                    waiting_since = math.nan
+                    now = time.monotonic()
+                    pacer.start(now)
             wait = pacer.wait_time(now)
             if wait > 0.0:
                 time.sleep(state.sleep_time(now, wait))  # ahead of the wall clock: never while catching up
@@ -222,9 +251,10 @@ class MujocoDriverNode:
                     tripped = self._read_state()
                 else:
                     self._sim_time = sim.time
+            current = publish
             pacer.step_done()
-            if tripped and self._driver is not None:  # only a publishing step reads the state
-                self._driver.on_reflex()
+            if tripped:  # only a publishing step reads the state
+                self._on_reflex()
             if self._clock_pub is not None and not catching_up:
                 self._publish_clock()
             if publish:
@@ -240,6 +270,24 @@ class MujocoDriverNode:
                 self._sync_viewer()
         if self._viewer is not None:
             self._viewer.close()
+
+    def _publish_current(self) -> None:
+        """The state now, when stepping skipped it: read, stamped on /clock, its wrench and joint states."""
+        with self._lock:
+            tripped = self._read_state()
+        if tripped:
+            self._on_reflex()
+        if self._clock_pub is not None:
+            self._publish_clock()
+        self._publish_wrench()
+        self._publish_state()
+
+    def _on_reflex(self) -> None:
+        """An emulated reflex stopped the arm: it refuses commands now, so there is nothing to wait for."""
+        if self._driver is not None:
+            self._driver.on_reflex()
+        if self._lockstep is not None:
+            self._lockstep.command(self._sim.time, moving=False)
 
     def _watchdog(self) -> None:
         """Velocity target to zero when velocity commands stopped coming (like a real velocity controller)."""
@@ -290,6 +338,8 @@ class MujocoDriverNode:
         f.x, f.y, f.z, t.x, t.y, t.z = w.tolist()
         self._state_stamp.secs, self._state_stamp.nsecs = self._stamp.secs, self._stamp.nsecs
         self._latency.wrench_sent(time.monotonic())
+        if self._lockstep is not None:
+            self._lockstep.published(self._stamp.secs * 1_000_000_000 + self._stamp.nsecs, self._sim_time)
         self._wrench_pub.publish(msg)
 
     def _publish_state(self) -> None:
@@ -382,6 +432,8 @@ class MujocoDriverNode:
         reason = self._driver.refusal(controller)
         if reason:
             self._reject(f"{controller} command", CommandError(reason))
+            if self._lockstep is not None:  # not following the stack: nothing to wait for
+                self._lockstep.command(self._sim.time, moving=False)
         return bool(reason)
 
     def _on_trajectory(self, msg: JointTrajectory, controller: str | None = None) -> None:
@@ -411,6 +463,8 @@ class MujocoDriverNode:
                 self._reject("trajectory", exc)
                 return
             self._velocity_active = False
+            if self._lockstep is not None:
+                self._lockstep.command(sim.time, moving=False)
 
     def _on_velocity(self, msg: Float64MultiArray, controller: str | None = None) -> None:
         self._latency.command_received(time.monotonic(), time.time())
@@ -425,6 +479,18 @@ class MujocoDriverNode:
                 return
             self._last_velocity_command = sim.time
             self._velocity_active = True
+            if self._lockstep is not None:
+                self._lockstep.command(sim.time, moving=any(msg.data))
+
+    def _on_echo(self, msg: rospy.AnyMsg) -> None:
+        """The stack answered a state: its stamp follows the header's seq (uint32 seq, secs, nsecs)."""
+        assert self._lockstep is not None  # subscribed only with a lockstep
+        try:
+            secs, nsecs = _STAMP.unpack_from(msg._buff, 4)
+        except struct.error:
+            self._reject("lockstep echo", CommandError(f"{len(msg._buff)} bytes: no std_msgs/Header first"))
+            return
+        self._lockstep.echo(secs * 1_000_000_000 + nsecs)
 
     def _check_push_frame(self, frame: str) -> None:
         if frame and frame.lstrip("/") != self._base_frame:
@@ -474,6 +540,8 @@ class MujocoDriverNode:
             if self._driver is not None:
                 self._driver.reset()
             self._velocity_active = False
+            if self._lockstep is not None:
+                self._lockstep.reset()
             self._read_state()
         return TriggerResponse(success=True, message="back at the start pose, holding position")
 

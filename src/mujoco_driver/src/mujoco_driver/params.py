@@ -100,6 +100,21 @@ class DriverSettings:
     max_lag: float = _pos(
         0.1, "s", "backlog behind the wall clock caught up without sleeping; a longer one is dropped (logged)"
     )
+    lockstep_lead: float = param(
+        0.01, unit="s", ge=0.0, le=0.1,
+        doc="while the arm is driven (a nonzero velocity command), step at most this far in simulated time "
+        "past the newest velocity command and the newest echo, then wait for the stack: a stalled "
+        "controller pauses the simulation instead of letting the arm drive on (README, Lockstep). 0: off",
+    )
+    lockstep_wait: float = _pos(
+        1.0, "s", "longest wait (wall time) for a silent stack; then the simulation runs on until it speaks "
+        "again, and `command_timeout` stops the arm"
+    )
+    lockstep_echo_topic: str = param(
+        "",
+        doc="a topic whose messages carry, first, a std_msgs/Header stamped with the wrench the controller "
+        "answered (contact_control's `~contact_wrench` when jog_arm runs apart); empty: commands only",
+    )
     rtf_period: float = _pos(2.0, "s", "window of `~rtf` (wall time)")
     publish_synchronously: bool = param(
         False,
