@@ -223,7 +223,7 @@ def test_a_request_re_sent_at_100_hz_during_a_push_does_not_change_the_motion(ro
             joints.wait_for(1, 20)
             # contact_control is processing wrenches (tared, data fresh) before the laws are set: pushing
             # within ~50 ms of start-up, before its first wrench, sometimes latched it at 237-262 N (see
-            # contact_control's README, Open items)
+            # contact_control's README, Known limits)
             wait_until(lambda: status.last() is not None and status.last().safety == 0, 20,
                        "contact_control to process wrenches")
             assert configure(req).success
