@@ -19,11 +19,14 @@ setup:
 build:
 	@scripts/bootstrap
 
-# Tests marked `alone` (minutes of pure computation on both cores) run after the others, not beside the
-# simulations (their timing is what the other tests judge); exit 5 is "none selected".
+# The simulations first, two workers; then the tests marked `compute` (minutes of pure computation: beside
+# a simulation they starve it, and its timing is what the other tests judge), two workers; then those marked
+# `alone`, one at a time. Exit 5 is "none selected".
 test: build
-	@$(ENV) python -m pytest $(if $(filter 0,$(PYTEST_WORKERS)),,-n $(PYTEST_WORKERS) --dist loadfile -m "not alone") \
-		$(PYTEST_ARGS)
+	@$(ENV) python -m pytest $(if $(filter 0,$(PYTEST_WORKERS)),,-n $(PYTEST_WORKERS) --dist loadfile \
+		-m "not alone and not compute") $(PYTEST_ARGS)
+	@$(if $(filter 0,$(PYTEST_WORKERS)),true,$(ENV) python -m pytest -n $(PYTEST_WORKERS) --dist loadfile \
+		-m compute $(PYTEST_ARGS) || [ $$? -eq 5 ])
 	@$(if $(filter 0,$(PYTEST_WORKERS)),true,$(ENV) python -m pytest -m alone $(PYTEST_ARGS) || [ $$? -eq 5 ])
 
 lint: build

@@ -14,6 +14,9 @@ from robot_setup.collisions import CollisionChecker
 from robot_setup.generate import GeneratorError, RobotSpec, main, plan_robot
 from robot_setup.plan import command_line, parse_held, parse_rpy, recorded_command
 
+# make robot's searches: after the simulations, not beside them (Makefile, test).
+pytestmark = pytest.mark.compute
+
 TIAGO = "tiago_description/robots/tiago_no_hand.urdf"
 ARM = tuple(f"arm_{i}_joint" for i in range(1, 8))
 AROUND = ("wheel_right_joint", "wheel_left_joint", "torso_lift_joint", "head_1_joint", "head_2_joint")

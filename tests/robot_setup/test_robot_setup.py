@@ -12,6 +12,9 @@ import yaml
 from robot_setup.check import check_package
 from robot_setup.generate import RobotSpec, recorded_command
 
+# make robot's searches: after the simulations, not beside them (Makefile, test).
+pytestmark = pytest.mark.compute
+
 SRC = pathlib.Path(__file__).resolve().parents[2] / "src"
 ROBOT_PACKAGES = sorted(p.name for p in SRC.iterdir() if p.name.endswith("_custom"))
 

@@ -15,6 +15,9 @@ from thesis_demos.scenarios import HYBRID_PUSH_DURATION, HYBRID_PUSH_START
 
 from robot_setup import generate
 
+# make robot's searches: after the simulations, not beside them (Makefile, test).
+pytestmark = pytest.mark.compute
+
 SO100 = RobotSpec("so100", "so_arm_description/urdf/so100.urdf", "gripper")
 HEXTILT = RobotSpec("hextilt", "hextilt_description/urdf/hextilt_flying_arm_5.urdf", "flying_arm_5__gripper")
 LEAST_HYBRID = HYBRID_PUSH_START + HYBRID_PUSH_DURATION + generate.HYBRID_AFTER_PUSH  # [s]
