@@ -38,9 +38,7 @@ def test_jogging_into_the_block_stops_under_the_guard_force_and_backing_out_work
                                                                                    single_process, speed):
     rospy = ros_node
     with run_launch(robot, "sim.launch", args={"single_process": str(single_process).lower()}) as h:
-        for topic in ("/mujoco_driver/eef_pose", "/wrench", "/jog_arm_server/status"):
-            h.wait_for_topic(topic, timeout=40)
-        h.wait_for_service("/contact_control_node/tare", timeout=40)
+        _wait_for_stack(h)
         pose = Collector("/mujoco_driver/eef_pose", PoseStamped)
         wrench = Collector("/wrench", WrenchStamped)
         status = Collector("/jog_arm_server/status", JogStatus)
@@ -135,9 +133,7 @@ def test_a_stalled_controller_pauses_the_simulation_instead_of_letting_the_jog_p
     at its force; without it the press goes on at the slow-zone speed (44 N and 72 N measured)."""
     rospy = ros_node
     with run_launch(robot, "sim.launch", args={"single_process": str(single_process).lower()}) as h:
-        for topic in ("/mujoco_driver/eef_pose", "/wrench", "/jog_arm_server/status"):
-            h.wait_for_topic(topic, timeout=40)
-        h.wait_for_service("/contact_control_node/tare", timeout=40)
+        _wait_for_stack(h)
         wrench = Collector("/wrench", WrenchStamped)
         status = Collector("/jog_arm_server/status", JogStatus)
         pub = rospy.Publisher("/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1, tcp_nodelay=True)
@@ -185,3 +181,9 @@ def test_a_stalled_controller_pauses_the_simulation_instead_of_letting_the_jog_p
 def _force(msg: WrenchStamped) -> np.ndarray:
     f = msg.wrench.force
     return np.array([f.x, f.y, f.z])
+
+
+def _wait_for_stack(h) -> None:
+    for topic in ("/mujoco_driver/eef_pose", "/wrench", "/jog_arm_server/status"):
+        h.wait_for_topic(topic, timeout=40)
+    h.wait_for_service("/contact_control_node/tare", timeout=40)
