@@ -92,3 +92,20 @@ def test_no_other_module_in_src_touches_rospy_internals():
              for path in src.glob("*/src/**/*.py") if path != allowed
              for n, line in enumerate(path.read_text().splitlines(), 1) if private.search(line)]
     assert found == [], "\n".join(found)
+
+
+def test_header_stamp_ns_reads_the_stamp_of_a_raw_stamped_message_and_refuses_a_short_one():
+    import io
+
+    from geometry_msgs.msg import WrenchStamped
+
+    msg = WrenchStamped()
+    msg.header.seq, msg.header.stamp = 7, rospy.Time(12, 345)
+    buff = io.BytesIO()
+    msg.serialize(buff)
+    raw = rospy.AnyMsg()
+    raw.deserialize(buff.getvalue())
+    assert rospy_internals.header_stamp_ns(raw) == 12_000_000_345
+    short = rospy.AnyMsg()
+    short.deserialize(b"\x00" * 8)
+    assert rospy_internals.header_stamp_ns(short) is None

@@ -19,6 +19,7 @@ from harness.waiting import Collector, wait_until
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
+from std_srvs.srv import Trigger
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 CONFIG = ROOT / "src" / "ur5_custom" / "config"
@@ -83,6 +84,9 @@ class Arm:
 
 @pytest.fixture
 def arm(driver, ros_node):
+    """The driver after ~reset (which forgets an echo an earlier test left armed), and its topics."""
+    ros_node.wait_for_service(f"{NS}/mujoco_driver/reset", 10)
+    assert ros_node.ServiceProxy(f"{NS}/mujoco_driver/reset", Trigger)().success
     a = Arm(ros_node, driver)
     yield a
     a.command(0.0, 0.05)

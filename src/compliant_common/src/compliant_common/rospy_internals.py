@@ -7,6 +7,8 @@ for them); tests/compliant_common/test_rospy_internals.py fails when rospy chang
   /use_sim_time parameter would say what the node was told, not what rospy does).
 * Registering again with a restarted master (`registrations`, `node_uri`, `publisher_update`): rospy
   registers only at init and has no public re-registration; compliant_common.master uses them.
+* The stamp of a message received as `rospy.AnyMsg` (`header_stamp_ns`: its raw bytes are the private
+  `_buff`): mujoco_driver's lockstep reads a controller's answers of any stamped type without deserialising.
 
 The clock: private rospy, on purpose. Under /use_sim_time, `rospy.init_node` subscribes the process to
 /clock, and rospy has no in-process delivery: every message the process publishes there would come back to
@@ -19,6 +21,7 @@ leave simulated time) nor set the clock (only that subscription's callback does)
 
 from __future__ import annotations
 
+import struct
 from collections.abc import Callable
 
 import rospy
@@ -27,8 +30,8 @@ import rospy.impl.simtime as _simtime
 from rospy.impl import registration
 from rospy.rostime import _set_rostime, is_wallclock
 
-__all__ = ["drop_clock_subscription", "is_wallclock", "node_uri", "publisher_update", "registrations",
-           "set_rostime"]
+__all__ = ["drop_clock_subscription", "header_stamp_ns", "is_wallclock", "node_uri", "publisher_update",
+           "registrations", "set_rostime"]
 
 
 def drop_clock_subscription() -> bool:
@@ -72,3 +75,16 @@ def publisher_update(topic: str, publishers: list[str]) -> bool:
         return False
     found[0].publisher_update(topic, publishers)
     return True
+
+
+_STAMP = struct.Struct("<II")  # a std_msgs/Header's stamp (secs, nsecs) after its uint32 seq
+
+
+def header_stamp_ns(msg: rospy.AnyMsg) -> int | None:
+    """The header stamp [ns] of a message received as `rospy.AnyMsg` whose type starts with a std_msgs/Header;
+    None when it is too short to have one."""
+    raw = msg._buff  # AnyMsg's raw bytes (see the module docstring)
+    if len(raw) < 12:
+        return None
+    secs, nsecs = _STAMP.unpack_from(raw, 4)
+    return int(secs) * 1_000_000_000 + int(nsecs)

@@ -13,7 +13,6 @@ import faulthandler
 import math
 import os
 import signal
-import struct
 import sys
 import threading
 import time
@@ -25,7 +24,7 @@ from compliant_common.diagnostics import Report
 from compliant_common.master import MasterWatch
 from compliant_common.ros_diagnostics import DiagnosticsPublisher
 from compliant_common.ros_time import timer
-from compliant_common.rospy_internals import drop_clock_subscription, set_rostime
+from compliant_common.rospy_internals import drop_clock_subscription, header_stamp_ns, set_rostime
 from compliant_common.runtime import tune_runtime
 from compliant_control_msgs.srv import PushEEF, PushEEFResponse
 from geometry_msgs.msg import PoseStamped, WrenchStamped
@@ -57,7 +56,6 @@ _MAX_STAMP_AHEAD = 1.0  # [s] stamps further in the future too
 # loaded 2-core machine, and skipping those states costs the stack's controllers a cycle each (and moves
 # contact_control's measured wrench rate, so its filter design, between ~0.9 and 1 kHz).
 _CATCH_UP_LAG = 0.002
-_STAMP = struct.Struct("<II")  # a std_msgs/Header's stamp after its uint32 seq
 _LOCKSTEP_SLICE = 0.005  # [s] a lockstep wait wakes this often to publish and to see a stop
 
 
@@ -483,14 +481,13 @@ class MujocoDriverNode:
                 self._lockstep.command(sim.time, moving=any(msg.data))
 
     def _on_echo(self, msg: rospy.AnyMsg) -> None:
-        """The stack answered a state: its stamp follows the header's seq (uint32 seq, secs, nsecs)."""
+        """The stack answered a state: the one its header stamp names."""
         assert self._lockstep is not None  # subscribed only with a lockstep
-        try:
-            secs, nsecs = _STAMP.unpack_from(msg._buff, 4)
-        except struct.error:
-            self._reject("lockstep echo", CommandError(f"{len(msg._buff)} bytes: no std_msgs/Header first"))
+        stamp = header_stamp_ns(msg)
+        if stamp is None:
+            self._reject("lockstep echo", CommandError("no std_msgs/Header first in the message"))
             return
-        self._lockstep.echo(secs * 1_000_000_000 + nsecs)
+        self._lockstep.echo(stamp)
 
     def _check_push_frame(self, frame: str) -> None:
         if frame and frame.lstrip("/") != self._base_frame:
