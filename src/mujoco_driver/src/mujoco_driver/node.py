@@ -122,6 +122,8 @@ class MujocoDriverNode:
         self._state_stamp = rospy.Time()  # the pending joint state's (the shared one moves with /clock)
         self._latency = LatencyProbe(horizon=s.command_timeout)
         self._lockstep = Lockstep(s.lockstep_lead) if s.lockstep_lead > 0.0 else None
+        # Published states are remembered only to place an echo's stamp: with no echo topic, not at all.
+        self._echoed = self._lockstep if s.lockstep_echo_topic else None
         self._latency_msg = Float64MultiArray()
         self._latency_msg.layout.dim = [MultiArrayDimension("command", 0, 0),
                                         MultiArrayDimension("received_wall_time_and_latency", 2, 2)]
@@ -162,7 +164,7 @@ class MujocoDriverNode:
             self._subs = self._driver.subscribe_commands(self._on_trajectory, self._on_velocity)
         self._subs.append(rospy.Subscriber("~push_wrench", WrenchStamped, self._on_push_wrench, queue_size=1,
                                            tcp_nodelay=True))
-        if self._lockstep is not None and s.lockstep_echo_topic:
+        if self._echoed is not None:
             # Raw bytes: only the header's stamp is read, whatever the type (no deserialisation).
             self._subs.append(rospy.Subscriber(s.lockstep_echo_topic, rospy.AnyMsg, self._on_echo,
                                                queue_size=1, tcp_nodelay=True))
@@ -336,8 +338,8 @@ class MujocoDriverNode:
         f.x, f.y, f.z, t.x, t.y, t.z = w.tolist()
         self._state_stamp.secs, self._state_stamp.nsecs = self._stamp.secs, self._stamp.nsecs
         self._latency.wrench_sent(time.monotonic())
-        if self._lockstep is not None:
-            self._lockstep.published(self._stamp.secs * 1_000_000_000 + self._stamp.nsecs, self._sim_time)
+        if self._echoed is not None:
+            self._echoed.published(self._stamp.secs * 1_000_000_000 + self._stamp.nsecs, self._sim_time)
         self._wrench_pub.publish(msg)
 
     def _publish_state(self) -> None:
@@ -482,12 +484,12 @@ class MujocoDriverNode:
 
     def _on_echo(self, msg: rospy.AnyMsg) -> None:
         """The stack answered a state: the one its header stamp names."""
-        assert self._lockstep is not None  # subscribed only with a lockstep
+        assert self._echoed is not None  # subscribed only with an echo topic
         stamp = header_stamp_ns(msg)
         if stamp is None:
             self._reject("lockstep echo", CommandError("no std_msgs/Header first in the message"))
             return
-        self._lockstep.echo(stamp)
+        self._echoed.echo(stamp)
 
     def _check_push_frame(self, frame: str) -> None:
         if frame and frame.lstrip("/") != self._base_frame:
