@@ -68,7 +68,7 @@ def test_set_rostime_moves_this_process_clock_to_a_copy_and_wakes_sleepers(rospy
 
 
 def test_the_registration_internals_master_watch_uses_are_there():
-    """What compliant_common.master re-registers with after a master restart (its behaviour end to end:
+    """What compliant_common.ros_master re-registers with after a master restart (its behaviour end to end:
     tests/robot_packages/test_robot_faults.py restarts roscore under the running stack)."""
     from rospy.impl import registration
 

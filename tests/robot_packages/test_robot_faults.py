@@ -17,7 +17,7 @@ pytest.importorskip("cartesian_impedance_msgs.srv", reason="needs devel/setup.ba
 
 from cartesian_impedance_msgs.msg import ControlLaw
 from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
-from compliant_common.master import MasterWatch
+from compliant_common.ros_master import MasterWatch
 from compliant_control_msgs.msg import ContactControlStatus, JogStatus
 from compliant_control_msgs.srv import PushEEF, PushEEFRequest
 from geometry_msgs.msg import PoseStamped

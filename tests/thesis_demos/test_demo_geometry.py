@@ -13,7 +13,7 @@ from thesis_demos.geometry import (
     preflight,
     tool_radius,
 )
-from thesis_demos.scenarios import SCENARIOS, build_scenarios, by_name
+from thesis_demos.scenarios import SCENARIOS, build_scenarios, by_name, fitted
 
 SRC = pathlib.Path(__file__).resolve().parents[2] / "src"
 ROBOT_PACKAGES = sorted(p for p in SRC.iterdir() if p.name.endswith("_custom"))
@@ -123,8 +123,8 @@ def floor(filtered_force: float, raw: float = 1.0):
 
 
 def test_the_contact_force_limit_is_per_driver_and_a_sensor_that_cannot_resolve_it_is_named():
+    from thesis_demos.cli import unresolvable
     from thesis_demos.geometry import DemoConfigError, DemoGeometry
-    from thesis_demos.main import unresolvable
     from thesis_demos.scenarios import by_name
 
     g = DemoGeometry.from_dict({"contact_force": {"limit": 0.5, "drivers": {"franka_ros": 1.5}}})
@@ -181,7 +181,7 @@ def test_the_taught_l_is_scaled_onto_the_block_and_a_block_too_small_is_named():
     assert "not under the tool tip" in fit_l((0.3, 0.1, 0.2), BOX, 0.03)
     # run_demos' scenarios get the arm's L; without a scene, the thesis-sized one stays.
     scenarios = by_name(["teach_and_replay", "spring_x"])
-    fitted = RobotSetup(DemoGeometry(), BOX, 0.03, checks_scene=True).fitted(scenarios, (0.6, 0.1, 0.2))
-    assert fitted[0].teach.legs == pytest.approx((-0.08, -0.04)) and "8 x 4 cm" in fitted[0].title
-    assert fitted[1] is scenarios[1]
-    assert RobotSetup(DemoGeometry()).fitted(scenarios, (0.6, 0.1, 0.2)) == scenarios
+    scaled = fitted(RobotSetup(DemoGeometry(), BOX, 0.03, checks_scene=True), scenarios, (0.6, 0.1, 0.2))
+    assert scaled[0].teach.legs == pytest.approx((-0.08, -0.04)) and "8 x 4 cm" in scaled[0].title
+    assert scaled[1] is scenarios[1]
+    assert fitted(RobotSetup(DemoGeometry()), scenarios, (0.6, 0.1, 0.2)) == scenarios

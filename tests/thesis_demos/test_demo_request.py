@@ -2,13 +2,14 @@
 
 import pytest
 
-runner = pytest.importorskip("thesis_demos.runner", reason="needs the built messages (make build)")
+law_requests = pytest.importorskip("thesis_demos.law_requests",
+                                   reason="needs the built messages (make build)")
 
 
 def test_hybrid_request_maps_each_axis_to_its_fields():
     from thesis_demos.scenarios import by_name
 
-    req = runner.build_request(by_name(["hybrid"])[0])
+    req = law_requests.build_request(by_name(["hybrid"])[0])
     p = req.cart_impedance_params
     assert (req.direction_control_laws.x.type, req.direction_control_laws.z.type) == (3, 2)
     assert req.direction_control_laws.y.type == 0
@@ -22,9 +23,9 @@ def test_hybrid_request_maps_each_axis_to_its_fields():
 def test_compliant_move_asks_to_move_away_and_the_others_to_stop():
     from thesis_demos.scenarios import by_name
 
-    action = runner.build_request(by_name(["compliant_move_z"])[0]).cart_impedance_params.max_ctrl_force
+    action = law_requests.build_request(by_name(["compliant_move_z"])[0]).cart_impedance_params.max_ctrl_force
     assert (action.exceeded_action.move_away, action.exceeded_action.stop) == (True, False)
-    action = runner.build_request(by_name(["hybrid"])[0]).cart_impedance_params.max_ctrl_force
+    action = law_requests.build_request(by_name(["hybrid"])[0]).cart_impedance_params.max_ctrl_force
     assert (action.exceeded_action.move_away, action.exceeded_action.stop) == (False, True)
 
 
@@ -34,10 +35,10 @@ def test_surface_following_presses_through_configure_laws_then_adds_the_x_move()
 
     scenario = by_name(["surface_following"])[0]
     assert scenario.uses_laws_service and not by_name(["hybrid"])[0].uses_laws_service
-    first = runner.build_laws_request(scenario.laws, scenario.exceeded_action)
+    first = law_requests.build_laws_request(scenario.laws, scenario.exceeded_action)
     assert (first.z.law, first.z.target_force, first.z.exceeded_action) == (4, SURFACE_TARGET_FORCE, 1)
     assert first.x.law == 0
-    then = runner.build_laws_request(scenario.follow_up.laws, scenario.exceeded_action)
+    then = law_requests.build_laws_request(scenario.follow_up.laws, scenario.exceeded_action)
     assert then.z == first.z  # the same press: contact_control keeps it going bumplessly
     assert (then.x.law, then.x.velocity, then.x.exceeded_action) == (3, -0.01, 0)  # no force limit: stop
     # contact_control takes both as they are (a target of +10 N presses down on the block).

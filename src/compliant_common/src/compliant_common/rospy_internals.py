@@ -6,7 +6,7 @@ for them); tests/compliant_common/test_rospy_internals.py fails when rospy chang
 * Whether rospy runs on the wall clock (`is_wallclock`: rospy.rostime's, marked "internal use"; the
   /use_sim_time parameter would say what the node was told, not what rospy does).
 * Registering again with a restarted master (`registrations`, `node_uri`, `publisher_update`): rospy
-  registers only at init and has no public re-registration; compliant_common.master uses them.
+  registers only at init and has no public re-registration; compliant_common.ros_master uses them.
 * The stamp of a message received as `rospy.AnyMsg` (`header_stamp_ns`: its raw bytes are the private
   `_buff`): mujoco_driver's lockstep reads a controller's answers of any stamped type without deserialising.
 

@@ -21,8 +21,8 @@ from cartesian_impedance_msgs.srv import (
     ConfigureForceControlResponse,
 )
 from compliant_common.diagnostics import Report
-from compliant_common.live_params import LiveParams
 from compliant_common.ros_diagnostics import DiagnosticsPublisher
+from compliant_common.ros_live_params import LiveParams
 from compliant_common.ros_time import TimerEvent, timer
 from compliant_control_msgs.msg import AxisState, ContactControlStatus, ContactEvent, PathReference
 from compliant_control_msgs.srv import (

@@ -15,9 +15,9 @@ import threading
 from collections.abc import Sequence
 
 import rospy
-from compliant_common.master import MasterWatch
+from compliant_common.ros_master import MasterWatch
+from compliant_common.ros_ticker import start_ticker
 from compliant_common.runtime import tune_runtime
-from compliant_common.ticker import start_ticker
 from contact_control.bias_map import BiasMapError
 from contact_control.ros_io import ContactControlRos, TfPoses, read_settings
 from contact_control.stage import Velocity

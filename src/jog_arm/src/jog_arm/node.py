@@ -11,10 +11,10 @@ import sys
 import threading
 
 import rospy
-from compliant_common.master import MasterWatch
+from compliant_common.ros_master import MasterWatch
+from compliant_common.ros_ticker import start_ticker
 from compliant_common.ros_time import JumpAwareClock
 from compliant_common.runtime import tune_runtime
-from compliant_common.ticker import start_ticker
 from geometry_msgs.msg import TwistStamped, WrenchStamped
 from sensor_msgs.msg import JointState
 

@@ -13,8 +13,8 @@ import pinocchio as pin
 import rospy
 import tf2_ros
 from compliant_common.diagnostics import Report
-from compliant_common.live_params import LiveParams
 from compliant_common.ros_diagnostics import DiagnosticsPublisher
+from compliant_common.ros_live_params import LiveParams
 from compliant_common.typedefs import ParamMap
 from compliant_control_msgs.msg import JogStatus
 from geometry_msgs.msg import Vector3

@@ -8,7 +8,7 @@ import time
 from typing import TextIO
 
 import rospy
-from compliant_common.master import MasterWatch
+from compliant_common.ros_master import MasterWatch
 from geometry_msgs.msg import TwistStamped
 
 from keyboard_publisher.keymap import Action, key_code, render_help, render_speeds

@@ -28,7 +28,7 @@ class ManipulatorControlPlugin(Plugin):
     def __init__(self, context) -> None:
         super().__init__(context)
         self.setObjectName("ManipulatorControlPlugin")
-        from manipulator_control_gui.app import create_widget
+        from manipulator_control_gui.ros_app import create_widget
 
         self._widget = create_widget()
         if context.serial_number() > 1:

@@ -4,7 +4,7 @@ One loop in the main thread steps the simulation in real time (a fixed wall-cloc
 :mod:`mujoco_driver.pacing`) and publishes the state; subscriber and service callbacks run in rospy's
 threads and only call into the simulation while holding ``_lock`` (``Simulation`` is not thread-safe).
 Messages and arrays are allocated once; the loop fills them in place. With ``~profile`` the node speaks as a
-real driver through an :class:`~mujoco_driver.emulated_driver.EmulatedDriver` it owns.
+real driver through an :class:`~mujoco_driver.ros_emulation.EmulatedDriver` it owns.
 """
 
 from __future__ import annotations
@@ -21,8 +21,8 @@ from typing import Any
 import numpy as np
 import rospy
 from compliant_common.diagnostics import Report
-from compliant_common.master import MasterWatch
 from compliant_common.ros_diagnostics import DiagnosticsPublisher
+from compliant_common.ros_master import MasterWatch
 from compliant_common.ros_time import timer
 from compliant_common.rospy_internals import drop_clock_subscription, header_stamp_ns, set_rostime
 from compliant_common.runtime import tune_runtime
@@ -36,13 +36,13 @@ from trajectory_msgs.msg import JointTrajectory
 
 from mujoco_driver.commands import trajectory_points, velocity_vector
 from mujoco_driver.config import ConfigError, SceneConfig
-from mujoco_driver.emulated_driver import EmulatedDriver, resolve_profile
 from mujoco_driver.health import driver_health
 from mujoco_driver.latency import LatencyProbe
 from mujoco_driver.lockstep import Lockstep
 from mujoco_driver.pacing import Pacer, RtfMeter, TrailingPublication
 from mujoco_driver.params import DriverParamError, DriverSettings, load_scene, urdf_root_link
 from mujoco_driver.profiles import DriverProfile, ProfileError
+from mujoco_driver.ros_emulation import EmulatedDriver, resolve_profile
 from mujoco_driver.scene import SceneError
 from mujoco_driver.sim import CommandError, Simulation
 

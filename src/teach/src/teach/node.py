@@ -36,7 +36,7 @@ from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 from teach.params import TeachParamError, TeachSettings, load_settings
 from teach.program import ProgramError, ProgramStore, check_name
 from teach.recorder import Recorder
-from teach.replay import ReplayServer
+from teach.replay_server import ReplayServer
 
 __all__ = ["TeachNode", "main", "robot_name"]
 

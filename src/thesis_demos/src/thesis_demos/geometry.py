@@ -452,18 +452,6 @@ class RobotSetup:
         """:func:`preflight` with this arm's obstacle and tool."""
         return preflight(self.geometry, tip, self.obstacle, self.tool_radius)
 
-    def fitted(self, scenarios: Sequence[Any], tip: Sequence[float]) -> list[Any]:
-        """`scenarios` with the teach-and-replay L fitted to this arm's block (:func:`fit_l`; unchanged
-        without a scene or when it does not fit: preflight says why)."""
-        from thesis_demos.scenarios import teach_and_replay
-
-        if not self.checks_scene:
-            return list(scenarios)
-        fitted = fit_l(tip, self.obstacle, self.tool_radius)
-        if isinstance(fitted, str):
-            return list(scenarios)
-        return [teach_and_replay(*fitted) if s.teach is not None else s for s in scenarios]
-
 
 def robot_setup(robot: str = "", demos_config: str = "") -> RobotSetup:
     """The demos' setup of robot package `<robot>_custom` (or a given demos.yaml; defaults when neither).

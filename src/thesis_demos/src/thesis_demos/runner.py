@@ -1,332 +1,52 @@
-"""Runs the demonstrations against a live stack, through its public ROS interface only.
-
-Services and topics used (all names are parameters of `run_demos`, defaults as the robot packages
-wire them): contact_control's `configure_cartesian_impedance` (`configure_laws` for force tracking),
-`~tare`, `~stop`, `~reset`, `~status`;
-the MuJoCo driver's `~push`, `~reset`, `~eef_pose` and the wrist `wrench` topic; tf for the sensor's
-orientation.
-"""
+"""Runs the demonstrations one after another against a live stack (its ROS side: thesis_demos.stack_client;
+the sixth demonstration's flow: thesis_demos.teach_client)."""
 
 from __future__ import annotations
 
-import threading
 import time
-from dataclasses import dataclass
 
-import numpy as np
-import rospy
-import tf2_ros
-from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
-from compliant_control_msgs.msg import ContactControlStatus, ContactEvent
-from compliant_control_msgs.srv import (
-    ConfigureLaws,
-    ConfigureLawsRequest,
-    MoveToNamedPose,
-    PushEEF,
-    PushEEFRequest,
-)
-from contact_control.noise_floor import NoiseFloor
-from contact_control.params import ContactControlSettings
-from geometry_msgs.msg import PoseStamped, WrenchStamped
-from std_srvs.srv import Trigger
+from compliant_control_msgs.srv import PushEEFRequest
 
 from thesis_demos.analysis import Recording
-from thesis_demos.scenarios import AXES, AxisLaw, Scenario
+from thesis_demos.scenarios import Scenario
+from thesis_demos.stack_client import Names, StackClient
+from thesis_demos.teach_client import TeachFlow
 
-__all__ = ["DemoRunner", "Names", "build_laws_request", "build_request"]
-
-_ACTIONS = {"stop": 0, "move_away": 1, "gravity_compensation": 2}  # compliant_control_msgs/AxisLaw ACTION_*
-
-
-@dataclass(frozen=True)
-class Names:
-    """Where the stack's interfaces live."""
-
-    configure: str = "/configure_cartesian_impedance"
-    configure_laws: str = "/configure_laws"
-    contact_control: str = "/contact_control_node"
-    driver: str = "/mujoco_driver"
-    named_poses: str = "/named_poses"  # its ~move_to brings the arm to "start" (else the driver's ~reset)
-    teach: str = "/teach"  # teach's program_server (teach and replay)
-    wrench: str = "/wrench"
-    base_frame: str = ""  # empty: contact_control's ~fixed_frame
+__all__ = ["DemoRunner", "Names"]
 
 
-def build_request(scenario: Scenario) -> ConfigureForceControlRequest:
-    """The ConfigureForceControl request for a scenario (the mapping in contact_control's README)."""
-    req = ConfigureForceControlRequest()
-    p = req.cart_impedance_params
-    for axis in AXES:
-        law = scenario.laws.get(axis)
-        if law is None:
-            continue
-        getattr(req.direction_control_laws, axis).type = law.law
-        rotational = axis.startswith("r")
-        c = axis[-1]
-        setattr(p.damping.rotational if rotational else p.damping.translational, c, law.damping)
-        setattr(p.stiffness.rotational if rotational else p.stiffness.translational, c, law.stiffness)
-        setattr(p.max_cart_vel.set.angular if rotational else p.max_cart_vel.set.linear, c, law.velocity)
-        limit = p.max_ctrl_force.set
-        if rotational:
-            setattr(limit.torque, c, law.torque_limit)
-        else:
-            setattr(limit.force, c, law.force_limit)
-        setattr(
-            p.max_path_deviation.rotation if rotational else p.max_path_deviation.translation,
-            c,
-            law.max_travel,
-        )
-    action = p.max_ctrl_force.exceeded_action
-    if scenario.exceeded_action not in ("stop", "move_away", "gravity_compensation"):
-        raise ValueError(f"{scenario.name}: unknown exceeded_action {scenario.exceeded_action!r}")
-    setattr(action, scenario.exceeded_action, True)
-    return req
-
-
-def build_laws_request(laws: dict[str, AxisLaw], exceeded_action: str = "stop") -> ConfigureLawsRequest:
-    """The compliant_control_msgs/ConfigureLaws request for laws per axis (force tracking needs it).
-
-    `exceeded_action` applies to every axis with a force (torque) limit, as in the original message.
-    """
-    if exceeded_action not in _ACTIONS:
-        raise ValueError(f"unknown exceeded_action {exceeded_action!r}")
-    req = ConfigureLawsRequest()
-    for axis, law in laws.items():
-        a = getattr(req, axis)
-        rotational = axis.startswith("r")
-        a.law, a.damping, a.stiffness, a.velocity = law.law, law.damping, law.stiffness, law.velocity
-        a.force_limit = law.torque_limit if rotational else law.force_limit
-        a.max_travel, a.target_force = law.max_travel, law.target_force
-        a.exceeded_action = _ACTIONS[exceeded_action] if a.force_limit > 0.0 else 0
-    return req
-
-
-class _Series:
-    """Thread-safe append-only time series of fixed width."""
-
-    def __init__(self, width: int) -> None:
-        self.t: list[float] = []
-        self.v: list[tuple[float, ...]] = []
-        self.width = width
-        self.lock = threading.Lock()
-
-    def add(self, t: float, values: tuple[float, ...]) -> None:
-        with self.lock:
-            self.t.append(t)
-            self.v.append(values)
-
-    def clear(self) -> None:
-        with self.lock:
-            self.t.clear()
-            self.v.clear()
-
-    def arrays(self, t0: float) -> tuple[np.ndarray, np.ndarray]:
-        with self.lock:
-            t = np.asarray(self.t, dtype=float) - t0
-            v = np.asarray(self.v, dtype=float).reshape(-1, self.width)
-        keep = t >= 0.0
-        return t[keep], v[keep]
-
-
-class DemoRunner:
+class DemoRunner(StackClient):
     """Connects to the stack once, then runs scenarios one after another."""
-
-    def __init__(self, names: Names, timeout: float = 60.0) -> None:
-        self.names = names
-        cc, drv = names.contact_control, names.driver
-        for service in (
-            names.configure,
-            names.configure_laws,
-            f"{cc}/tare",
-            f"{cc}/stop",
-            f"{cc}/reset",
-            f"{drv}/push",
-            f"{drv}/reset",
-        ):
-            rospy.wait_for_service(service, timeout=timeout)
-        self._configure = rospy.ServiceProxy(names.configure, ConfigureForceControl)
-        self._configure_laws = rospy.ServiceProxy(names.configure_laws, ConfigureLaws)
-        self._tare = rospy.ServiceProxy(f"{cc}/tare", Trigger)
-        self._stop = rospy.ServiceProxy(f"{cc}/stop", Trigger)
-        self._reset_safety = rospy.ServiceProxy(f"{cc}/reset", Trigger)
-        self._push = rospy.ServiceProxy(f"{drv}/push", PushEEF)
-        self._reset_sim = rospy.ServiceProxy(f"{drv}/reset", Trigger)
-        self._move_to: rospy.ServiceProxy | None = None
-        try:  # started by the same launch as the rest, so it is there by now or not at all
-            rospy.wait_for_service(f"{names.named_poses}/move_to", timeout=5.0)
-            self._move_to = rospy.ServiceProxy(f"{names.named_poses}/move_to", MoveToNamedPose)
-        except rospy.ROSException:
-            rospy.logwarn("thesis_demos: no %s/move_to: the driver's ~reset brings the arm to its start pose",
-                          names.named_poses)
-        self._base_frame = names.base_frame or rospy.get_param(
-            f"{cc}/fixed_frame", ContactControlSettings.fixed_frame
-        )
-        self._tf = tf2_ros.Buffer()
-        self._tf_listener = tf2_ros.TransformListener(self._tf)
-        self._pose = _Series(3)
-        self._status = _Series(6)
-        self._wrench = _Series(3)
-        self._status_lock = threading.Lock()
-        self._last_status: ContactControlStatus | None = None
-        self._move_ends: list[float] = []  # stamps of contact_control's move_ended events [s]
-        self._sensor_rotation: np.ndarray | None = None
-        self._subs = [
-            rospy.Subscriber(f"{drv}/eef_pose", PoseStamped, self._on_pose, queue_size=100, tcp_nodelay=True),
-            rospy.Subscriber(
-                f"{cc}/status", ContactControlStatus, self._on_status, queue_size=100, tcp_nodelay=True
-            ),
-            rospy.Subscriber(names.wrench, WrenchStamped, self._on_wrench, queue_size=100, tcp_nodelay=True),
-            rospy.Subscriber(f"{cc}/events", ContactEvent, self._on_event, queue_size=20, tcp_nodelay=True),
-        ]
-        self._wait(lambda: self._pose.t and self._last_status is not None, timeout, "eef_pose and status")
-
-    # --- callbacks ---
-    def _on_pose(self, msg: PoseStamped) -> None:
-        p = msg.pose.position
-        self._pose.add(msg.header.stamp.to_sec(), (p.x, p.y, p.z))
-
-    def _on_status(self, msg: ContactControlStatus) -> None:
-        f, v = msg.wrench.force, msg.velocity.linear
-        self._status.add(msg.header.stamp.to_sec(), (f.x, f.y, f.z, v.x, v.y, v.z))
-        with self._status_lock:
-            self._last_status = msg
-
-    def _on_event(self, msg: ContactEvent) -> None:
-        if msg.type == ContactEvent.MOVE_ENDED:
-            with self._status_lock:
-                self._move_ends.append(msg.header.stamp.to_sec())
-
-    def _ended_at(self, seen: float) -> float:
-        """When the move the runner saw end at `seen` [s, rospy time] ended: the last move_ended event's stamp
-        up to then (its cycle), else `seen`. Polling status saw it up to a status period late, more on a busy
-        machine, and the force's jolt as the tool stops then fell inside the judged window."""
-        with self._status_lock:
-            stamps = [t for t in self._move_ends if t <= seen]
-        return stamps[-1] if stamps else seen
-
-    def _on_wrench(self, msg: WrenchStamped) -> None:
-        if self._sensor_rotation is None:
-            return
-        f = msg.wrench.force
-        world = self._sensor_rotation @ np.array((f.x, f.y, f.z))
-        self._wrench.add(msg.header.stamp.to_sec(), tuple(world))
-
-    # --- helpers ---
-    @staticmethod
-    def _wait(predicate, timeout: float, what: str) -> None:
-        deadline = time.monotonic() + timeout
-        while not predicate():
-            if time.monotonic() > deadline or rospy.is_shutdown():
-                raise TimeoutError(f"timed out waiting for {what}")
-            time.sleep(0.01)
-
-    def _update_sensor_rotation(self, sensor_frame: str) -> None:
-        tf = self._tf.lookup_transform(
-            self._base_frame, sensor_frame, rospy.Time(0), rospy.Duration(5.0)
-        )
-        q = tf.transform.rotation
-        x, y, z, w = q.x, q.y, q.z, q.w
-        # The wrench is read as contact_control reads it: its ft_*_direction sign flips first (a driver that
-        # reports the wrench the robot exerts has all three -1 in its robot package's hardware YAML).
-        signs = [self.contact_setting(f"ft_{a}_direction") for a in "xyz"]
-        self._sensor_rotation = np.array(
-            [
-                [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-            ]
-        ) @ np.diag(signs)
-
-    def _settle(self, timeout: float = 10.0, window: float = 0.3, tolerance: float = 2e-4) -> None:
-        """Waits until the tool has moved less than `tolerance` over `window` seconds."""
-
-        self._pose.clear()
-        self._wait(lambda: self.still(window, tolerance), timeout, "the arm to settle")
-
-    def still(self, window: float = 0.3, tolerance: float = 2e-4) -> bool:
-        """Whether the tool has moved less than `tolerance` [m] over the last `window` seconds recorded."""
-        with self._pose.lock:
-            if not self._pose.t or self._pose.t[-1] - self._pose.t[0] < window:
-                return False
-            since = self._pose.t[-1] - window
-            recent = [v for t, v in zip(self._pose.t, self._pose.v, strict=True) if t > since]
-        return float(np.ptp(np.asarray(recent), axis=0).max()) < tolerance
-
-    def _move_state(self) -> tuple[bool, dict[str, int]]:
-        """(whether the move or its exceeded action, e.g. moving away, still runs; end condition per axis)."""
-        with self._status_lock:
-            status = self._last_status
-        ends = {a.axis: a.end_condition for a in status.axes} if status else {}
-        return bool(status and (status.move_active or status.reacting)), ends
-
-    def start_tip(self) -> tuple[float, float, float]:
-        """Returns the arm to its start pose, waits until still, and gives the tool tip [m]."""
-        self._to_start()
-        with self._pose.lock:
-            return tuple(self._pose.v[-1])  # type: ignore[return-value]
-
-    def _to_start(self) -> None:
-        """Named pose `start` (a joint-space move, as on a real arm), else the driver's reset; then still."""
-        self._stop()
-        if self._move_to is not None:
-            self._settle()  # the stop's last zero commands are through before the trajectory goes out
-            result = self._move_to(name="start", speed_scale=1.0)
-            if not result.success:
-                raise RuntimeError(f"named pose 'start' failed: {result.message}")
-        else:
-            result = self._reset_sim()
-            if not result.success:
-                raise RuntimeError(f"driver reset failed: {result.message}")
-        self._settle()
-
-    # --- one scenario ---
-    def prepare(self, sensor_frame: str) -> float:
-        """The start pose, the safety reset, the sensor tared, the series cleared; returns when the tared
-        sensor's baseline began: 0.3 s of it before anything moves is the recorded contact force's zero (the
-        few ms of the configure call alone could leave a loaded machine without a wrench)."""
-        self._to_start()
-        self._reset_safety()
-        tare = self._tare()
-        if not tare.success:
-            raise RuntimeError(f"tare failed: {tare.message}")
-        self._update_sensor_rotation(sensor_frame)
-        for series in (self._pose, self._status, self._wrench):
-            series.clear()
-        baseline_t = rospy.get_time()
-        time.sleep(0.3)
-        return baseline_t
 
     def run(self, scenario: Scenario, sensor_frame: str) -> Recording:
         """Brings the arm to its start pose, sets the scenario's laws, pushes, and records until done (teach
-        and replay: its own flow, thesis_demos.teach_flow)."""
+        and replay: its own flow, thesis_demos.teach_client)."""
         if scenario.teach is not None:
-            from thesis_demos.teach_flow import TeachFlow
-
             return TeachFlow(self, self.names.teach).run(scenario, sensor_frame)
         baseline_t = self.prepare(sensor_frame)
-        self._send(scenario, scenario.laws)
-        t0 = rospy.get_time()
+        self.send(scenario, scenario.laws)
+        t0 = self.now()
         pushes = sorted(scenario.pushes, key=lambda p: p.start)
         end_time = None
         follow_up, follow_up_time, settled_since = scenario.follow_up, None, None
-        while not rospy.is_shutdown():
-            now = rospy.get_time() - t0
+        while not self.shutting_down():
+            now = self.now() - t0
             if follow_up is not None and follow_up_time is None:
                 # Sent once the force has stayed near its target for follow_up.hold (pressing on the block).
-                force = self._force(follow_up.axis)
+                force = self.force(follow_up.axis)
                 if force is not None and abs(force - follow_up.target) <= follow_up.tolerance:
                     settled_since = now if settled_since is None else settled_since
                     if now - settled_since >= follow_up.hold:
-                        self._send(scenario, follow_up.laws)
-                        follow_up_time = rospy.get_time() - t0
+                        self.send(scenario, follow_up.laws)
+                        follow_up_time = self.now() - t0
                 else:
                     settled_since = None
             while pushes and now >= pushes[0].start:
                 push = pushes.pop(0)
                 req = PushEEFRequest(duration=push.duration)
                 req.wrench.force.x, req.wrench.force.y, req.wrench.force.z = push.force
-                self._push(req)
-            active, _ = self._move_state()
+                self.push(req)
+            active, _ = self.move_state()
             if end_time is None and not active and now > 0.2:
                 end_time = now
             if now >= scenario.duration:
@@ -334,95 +54,10 @@ class DemoRunner:
             if scenario.end_when_move_ends and end_time is not None and now >= end_time + scenario.settle:
                 break
             time.sleep(0.005)
-        _, ends = self._move_state()
-        self._stop()
+        _, ends = self.move_state()
+        self.stop()
         if end_time is not None:
-            end_time = self._ended_at(end_time + t0) - t0
-        recording = self._recording(t0, baseline_t, ends, end_time)
+            end_time = self.ended_at(end_time + t0) - t0
+        recording = self.recording(t0, baseline_t, ends, end_time)
         recording.follow_up_time = follow_up_time
         return recording
-
-    def _send(self, scenario: Scenario, laws: dict[str, AxisLaw]) -> None:
-        """Sends laws through configure_laws when the scenario needs it, else the original service."""
-        if scenario.uses_laws_service:
-            answer = self._configure_laws(build_laws_request(laws, scenario.exceeded_action))
-            if not answer.success:
-                raise RuntimeError(f"{scenario.name}: contact_control refused the laws: {answer.message}")
-            return
-        response = self._configure(build_request(scenario))
-        if not response.success:
-            raise RuntimeError(f"{scenario.name}: contact_control refused the request (see its ~status)")
-
-    def contact_setting(self, name: str) -> float:
-        """contact_control's parameter `name` as the node reads it (its default if unset)."""
-        default = getattr(ContactControlSettings, name)
-        return float(rospy.get_param(f"{self.names.contact_control}/{name}", default))
-
-    def pose_residual(self) -> tuple[float, float]:
-        """How far contact_control takes its sensor's offset to move over the workspace beyond the noise
-        (force [N], torque [Nm]): its bias map's held-out residual, else its pose_offset_force / _torque.
-
-        Raises:
-            RuntimeError: The bias map file cannot be read (the node would not have started either).
-        """
-        from contact_control.bias_map import BiasMapError, load_bias_map
-
-        path = str(rospy.get_param(f"{self.names.contact_control}/bias_map", ""))
-        if path:
-            try:
-                loaded = load_bias_map(path)
-            except BiasMapError as err:
-                raise RuntimeError(str(err)) from err
-            return loaded.residual_force, loaded.residual_torque
-        return self.contact_setting("pose_offset_force"), self.contact_setting("pose_offset_torque")
-
-    def noise_floor(self, timeout: float = 10.0) -> NoiseFloor | None:
-        """contact_control's noise floor as its ~status reports it (measured while zeroing); None when it
-        reports none (not zeroed, or an older node)."""
-
-        def reported() -> bool:  # a noise floor, or zeroed without one
-            with self._status_lock:
-                status = self._last_status
-            return status is not None and (len(status.noise_filtered) == 6
-                                           or status.safety != ContactControlStatus.SAFETY_ZEROING)
-
-        try:
-            self._wait(reported, timeout, "contact_control's zeroing")
-        except TimeoutError:
-            return None
-        with self._status_lock:
-            status = self._last_status
-        if status is None or len(status.noise_filtered) != 6:
-            return None
-        return NoiseFloor(tuple(status.noise_std), 0.0, 0, tuple(status.noise_filtered))
-
-    def _force(self, axis: str) -> float | None:
-        """The controller's latest force [N] along `axis` (x, y or z; control frame), None before a status."""
-        with self._status_lock:
-            status = self._last_status
-        return None if status is None else getattr(status.wrench.force, axis)
-
-    def _recording(
-        self, t0: float, baseline_t: float, ends: dict[str, int], end_time: float | None
-    ) -> Recording:
-        pose_t, pose = self._pose.arrays(t0)
-        status_t, status = self._status.arrays(t0)
-        wrench_t_all, wrench_all = self._wrench.arrays(baseline_t)
-        before = wrench_t_all < (t0 - baseline_t)
-        bias = wrench_all[before].mean(axis=0) if np.any(before) else np.zeros(3)
-        after = ~before
-        return Recording(
-            pose_t=pose_t,
-            pose=pose,
-            status_t=status_t,
-            force=status[:, :3],
-            command=status[:, 3:],
-            wrench_t=wrench_t_all[after] - (t0 - baseline_t),
-            contact_force=wrench_all[after] - bias,
-            end_conditions=ends,
-            move_end_time=end_time,
-        )
-
-    def close(self) -> None:
-        for sub in self._subs:
-            sub.unregister()

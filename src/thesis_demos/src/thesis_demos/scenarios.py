@@ -7,11 +7,13 @@ Pure: no rospy. Forces are in the robot's base frame [N]; velocities [m/s]; dist
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from thesis_demos.geometry import SURFACE_DIRECTION, SURFACE_TRAVEL, DemoGeometry
+from thesis_demos.geometry import SURFACE_DIRECTION, SURFACE_TRAVEL, DemoGeometry, RobotSetup, fit_l
 
-__all__ = ["SCENARIOS", "AxisLaw", "FollowUp", "Push", "Scenario", "TeachL", "build_scenarios", "by_name"]
+__all__ = ["SCENARIOS", "AxisLaw", "FollowUp", "Push", "Scenario", "TeachL", "build_scenarios", "by_name",
+           "fitted"]
 
 AXES = ("x", "y", "z", "rx", "ry", "rz")
 # cartesian_impedance_msgs/ControlLaw
@@ -89,7 +91,7 @@ class Scenario:
     # gravity_compensation.
     exceeded_action: str = "stop"
     follow_up: FollowUp | None = None  # a second request during the run (surface following: the X move)
-    teach: TeachL | None = None  # teach and replay: the L taught by hand (own flow: thesis_demos.teach_flow)
+    teach: TeachL | None = None  # the L taught by hand (its own flow: thesis_demos.teach_client)
     press_force: float = 0.0  # [N] force tracking's target on a pressed replay (0: none)
 
     @property
@@ -286,3 +288,14 @@ def by_name(names: list[str] | None, geometry: DemoGeometry | None = None) -> li
     if missing:
         raise KeyError(f"unknown demo(s) {missing}; known: {sorted(known)}")
     return [known[n] for n in names]
+
+
+def fitted(setup: RobotSetup, scenarios: Sequence[Scenario], tip: Sequence[float]) -> list[Scenario]:
+    """`scenarios` with the teach-and-replay L fitted to the arm's block (geometry.fit_l; unchanged without
+    a scene or when it does not fit: the preflight says why)."""
+    if not setup.checks_scene:
+        return list(scenarios)
+    corner_and_legs = fit_l(tip, setup.obstacle, setup.tool_radius)
+    if isinstance(corner_and_legs, str):
+        return list(scenarios)
+    return [teach_and_replay(*corner_and_legs) if s.teach is not None else s for s in scenarios]

@@ -100,7 +100,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     from thesis_demos.plotting import plot
     from thesis_demos.report import markdown
     from thesis_demos.runner import DemoRunner, Names
-    from thesis_demos.scenarios import by_name
+    from thesis_demos.scenarios import by_name, fitted
 
     try:
         setup = robot_setup(args.robot, args.demos_config)
@@ -120,7 +120,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             # Plain words before anything moves: what this arm's start pose and scene do not allow.
             tip = runner.start_tip()
             cannot = setup.preflight(tip)
-            scenarios = setup.fitted(scenarios, tip)
+            scenarios = fitted(setup, scenarios, tip)
             for name, reason in cannot.items():
                 if any(s.name == name for s in scenarios):
                     print(f"[CANNOT] {name}: this arm cannot do it as configured: {reason}", flush=True)

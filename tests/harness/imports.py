@@ -1,14 +1,30 @@
-"""robot_setup's modules import one another without a cycle. Every import counts, at module level, inside a
-function or under TYPE_CHECKING: an import moved into a function still ties the two modules together (the
-templates once imported `generate` inside `render`, and `generate` imported the templates). No ROS master."""
+"""Import graphs read from source (ast, nothing imported): every import counts, at module level, inside a
+function or under TYPE_CHECKING, since an import moved into a function still ties two modules together."""
 
 from __future__ import annotations
 
 import ast
 import pathlib
-import textwrap
 
-ROBOT_SETUP = pathlib.Path(__file__).resolve().parents[2] / "src" / "robot_setup" / "src" / "robot_setup"
+__all__ = ["find_cycle", "import_graph", "imported_names", "packages"]
+
+SRC = pathlib.Path(__file__).resolve().parents[2] / "src"
+
+
+def packages(src: pathlib.Path = SRC) -> dict[str, pathlib.Path]:
+    """Python package name -> its folder, for every catkin package under `src` with a Python library."""
+    return {init.parent.name: init.parent for init in sorted(src.glob("*/src/*/__init__.py"))}
+
+
+def imported_names(path: pathlib.Path) -> set[str]:
+    """Top-level names of everything a module imports (absolute imports; relative ones are its own)."""
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.Import):
+            names.update(alias.name.split(".")[0] for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            names.add(node.module.split(".")[0])
+    return names
 
 
 def _modules(root: pathlib.Path) -> dict[str, pathlib.Path]:
@@ -75,47 +91,3 @@ def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
         if cycle:
             return cycle
     return None
-
-
-def test_robot_setup_has_no_import_cycle():
-    graph = import_graph(ROBOT_SETUP)
-    # The scan sees the imports that matter: generate -> templates -> plan, a template -> its helpers.
-    assert "robot_setup.templates" in graph["robot_setup.generate"]
-    assert "robot_setup.plan" in graph["robot_setup.templates.text"]
-    assert "robot_setup.templates.text" in graph["robot_setup.templates.sim_yaml"]
-    assert find_cycle(graph) is None
-
-
-def test_a_cycle_through_function_level_imports_is_found(tmp_path):
-    """The old shape: generate imported the templates inside `render`, the templates imported generate
-    inside theirs (and under TYPE_CHECKING)."""
-    package = tmp_path / "robot_setup"
-    package.mkdir()
-    (package / "__init__.py").write_text("")
-    (package / "generate.py").write_text(textwrap.dedent("""\
-        def command_line():
-            return ""
-
-
-        def render(plan):
-            from robot_setup import templates
-
-            return templates.render(plan)
-    """))
-    (package / "templates.py").write_text(textwrap.dedent("""\
-        from typing import TYPE_CHECKING
-
-        if TYPE_CHECKING:
-            from robot_setup.generate import Plan
-
-
-        def render(plan: Plan):
-            from .generate import command_line
-
-            return command_line()
-    """))
-    graph = import_graph(package)
-    assert graph["robot_setup.templates"] == {"robot_setup.generate"}
-    assert find_cycle(graph) == ["robot_setup.generate", "robot_setup.templates", "robot_setup.generate"]
-    (package / "templates.py").write_text("def render(plan):\n    return ''\n")
-    assert find_cycle(import_graph(package)) is None

@@ -18,9 +18,9 @@ pytest.importorskip("controller_manager_msgs.srv", reason="needs devel/setup.bas
 import actionlib
 import rospy
 from mujoco_driver.controllers import STRICT
-from mujoco_driver.emulated_driver import EmulatedDriver, resolve_profile
 from mujoco_driver.params import DriverSettings
 from mujoco_driver.profiles import load_profile
+from mujoco_driver.ros_emulation import EmulatedDriver, resolve_profile
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 

@@ -2,7 +2,7 @@
 two compliant moves bring the tool over the L's first corner; contact_control's `~guide` on, teach's
 `~record`; the simulated hand (the driver's `~push`) pushes the tool along each leg until it is nearly
 there; `~stop` saves the program, guide off; teach's `~replay` action plays it back in free space at 1 x and
-TEACH_FAST x, then pressing on Z, slowed to a top speed of TEACH_PRESS_VELOCITY. The DemoRunner records the
+TEACH_FAST x, then pressing on Z, slowed to a top speed of TEACH_PRESS_VELOCITY. The StackClient records the
 tool, the status and the sensor throughout.
 """
 
@@ -11,7 +11,6 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from typing import TYPE_CHECKING
 
 import actionlib
 import numpy as np
@@ -35,9 +34,7 @@ from thesis_demos.scenarios import (
     AxisLaw,
     Scenario,
 )
-
-if TYPE_CHECKING:
-    from thesis_demos.runner import DemoRunner
+from thesis_demos.stack_client import StackClient
 
 __all__ = ["PROGRAM", "TeachFlow"]
 
@@ -50,12 +47,12 @@ REPLAY_TIMEOUT = 90.0  # [s] per replay (the pressed one: a 5 mm/s approach over
 
 
 class TeachFlow:
-    """Runs teach and replay with a DemoRunner's connections and series (its helpers are this package's)."""
+    """Runs teach and replay with a StackClient's connections and series."""
 
-    def __init__(self, runner: DemoRunner, teach: str = "/teach", timeout: float = 30.0) -> None:
-        self.r = runner
+    def __init__(self, stack: StackClient, teach: str = "/teach", timeout: float = 30.0) -> None:
+        self.r = stack
         self._t0 = 0.0
-        cc = runner.names.contact_control
+        cc = stack.names.contact_control
         for service in (f"{teach}/record", f"{teach}/stop", f"{cc}/guide"):
             try:
                 rospy.wait_for_service(service, timeout=timeout)
@@ -73,11 +70,10 @@ class TeachFlow:
 
     # --- the parts ---
     def _tip(self) -> np.ndarray:
-        with self.r._pose.lock:
-            return np.asarray(self.r._pose.v[-1], dtype=float)
+        return self.r.tip()
 
     def _wait(self, predicate: Callable[[], object], timeout: float, what: str) -> None:
-        self.r._wait(predicate, timeout, what)
+        self.r.wait(predicate, timeout, what)
 
     def _move_along(self, axis: int, distance: float) -> None:
         """A compliant move of `distance` [m] along base axis `axis`, ended by its max path deviation."""
@@ -87,16 +83,16 @@ class TeachFlow:
         law = AxisLaw(
             COMPLIANT_MOVE, velocity=math.copysign(POSITIONING_SPEED, distance), max_travel=abs(distance)
         )
-        self.r._send(
+        self.r.send(
             Scenario(name="teach_and_replay: to the corner", title="", laws={name: law}), {name: law}
         )
-        self._wait(lambda: self.r._move_state()[0], 5.0, f"the move along {name} to start")
+        self._wait(lambda: self.r.move_state()[0], 5.0, f"the move along {name} to start")
         self._wait(
-            lambda: not self.r._move_state()[0],
+            lambda: not self.r.move_state()[0],
             10.0 + 2 * abs(distance) / POSITIONING_SPEED,
             f"the move along {name} to end",
         )
-        ended = self.r._move_state()[1].get(name)
+        ended = self.r.move_state()[1].get(name)
         if ended != 2:  # MAX_TRAVEL
             raise RuntimeError(
                 f"the move to the L's corner along {name} ended by condition {ended}, not by its "
@@ -109,7 +105,7 @@ class TeachFlow:
         start = self._tip()
         request = PushEEFRequest(duration=10.0)
         setattr(request.wrench.force, "xyz"[axis], math.copysign(TEACH_PUSH, leg))
-        answer = self.r._push(request)
+        answer = self.r.push(request)
         if not answer.success:
             raise RuntimeError(f"the driver refused the push: {answer.message}")
         deadline = time.monotonic() + 20.0
@@ -122,7 +118,7 @@ class TeachFlow:
             previous, previous_t = tip, now
             if abs(tip[axis] - start[axis]) >= abs(leg) - speed * COAST_TIME:
                 break
-        self.r._push(PushEEFRequest(duration=0.0))  # let go
+        self.r.push(PushEEFRequest(duration=0.0))  # let go
         self._wait(lambda: not self.r.still(), 5.0, "the guided tool to move")
         self._wait(self.r.still, 15.0, "the guided tool to come to rest")
 
@@ -166,7 +162,7 @@ class TeachFlow:
 
     def _top_speed(self, start: float, end: float) -> float:
         """The tool's top speed [m/s] between `start` and `end` (recording time), over 50 ms differences."""
-        t, p = self.r._pose.arrays(self._t0)
+        t, p = self.r.pose.arrays(self._t0)
         keep = (t >= start) & (t <= end)
         t, p = t[keep], p[keep]
         step = max(1, int(0.05 / max(float(np.median(np.diff(t))), 1e-4))) if len(t) > 2 else 1
@@ -211,8 +207,8 @@ class TeachFlow:
             replays.append(replayed)
             if not replayed.success:
                 break  # the arm may still be moving away: the next replay would be refused
-        _, ends = r._move_state()
-        recording = r._recording(t0, baseline_t, ends, None)
+        _, ends = r.move_state()
+        recording = r.recording(t0, baseline_t, ends, None)
         recording.taught = taught
         recording.replays = replays
         return recording
