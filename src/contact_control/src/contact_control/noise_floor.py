@@ -5,7 +5,7 @@ What the laws see is that noise after the low-pass filter. For white noise a sec
 filter with cutoff fc at sample rate fs passes a fraction 2 * 1.1107 * fc / fs of its variance (1.1107 fc
 is that filter's equivalent noise bandwidth, B). Real sensors' noise is mostly slow, not white (a
 joint-torque estimate and a built-in wrist sensor recorded at rest: lag-1 autocorrelations 0.6-0.97, fitted
-with mujoco_driver's fit_sensor; the package README): taken as first-order noise with the measured lag-1
+with sensor_fit's fit_sensor; the package README): taken as first-order noise with the measured lag-1
 correlation a (correlation time tau = -T / ln a), a fraction (2 / pi) atan(2 pi tau B) of its variance
 passes. The larger of the two is used.
 """
