@@ -11,7 +11,7 @@ import time
 import pytest
 from compliant_common.diagnostics import ERROR, OK, WARN, Report, rate_check, summary
 from contact_control.axes import SAFETY_OK, SAFETY_STALE, SAFETY_ZEROING
-from contact_control.controller import CycleResult
+from contact_control.cycle import CycleResult
 from contact_control.health import contact_health
 from contact_control.noise_floor import NoiseFloor
 from contact_control.params import load_settings

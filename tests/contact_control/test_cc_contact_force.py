@@ -14,17 +14,17 @@ def test_contact_force_is_compensated_and_rotated_but_not_filtered():
     T[:3, :3] = R  # control frame = fixed frame
     weight = R.T @ np.array([0.0, 0.0, -9.81])  # the tool's weight as the sensor reads it
     at_rest = [*weight, 0.0, 0.0, 0.0]
-    ctrl.tare(at_rest, R)
+    ctrl.intake.tare(at_rest, R)
     for i in range(50):
         ctrl.update(at_rest, i * 0.002, T, R)
-    assert ctrl.contact_force(at_rest, T, R) == pytest.approx((0.0, 0.0, 0.0), abs=1e-9)
+    assert ctrl.intake.contact_force(at_rest, T, R) == pytest.approx((0.0, 0.0, 0.0), abs=1e-9)
     # The table pushes the tool up with 10 N: the step shows at once, the filtered force lags behind.
     pressed = [*(weight + R.T @ np.array([0.0, 0.0, 10.0])), 0.0, 0.0, 0.0]
     result = ctrl.update(pressed, 0.1, T, R)
-    assert ctrl.contact_force(pressed, T, R) == pytest.approx((0.0, 0.0, 10.0), abs=1e-9)
+    assert ctrl.intake.contact_force(pressed, T, R) == pytest.approx((0.0, 0.0, 10.0), abs=1e-9)
     assert result.wrench[2] < 1.0
-    assert ctrl.contact_force([float("nan"), 0, 0, 0, 0, 0], T, R) is None
-    assert ctrl.contact_force(pressed, T, None) is None  # with a tool model the orientation is needed
+    assert ctrl.intake.contact_force([float("nan"), 0, 0, 0, 0, 0], T, R) is None
+    assert ctrl.intake.contact_force(pressed, T, None) is None  # with a tool model the orientation is needed
 
 
 def test_contact_force_is_the_unfiltered_force_of_the_chain():
@@ -37,9 +37,10 @@ def test_contact_force_is_the_unfiltered_force_of_the_chain():
     T = np.eye(4)
     T[:3, :3] = rot([0.0, 0.0, 1.0], 0.7)
     T[:3, 3] = [0.1, -0.2, 0.3]
-    ctrl.tare([0.5, -1.0, 2.0, 0.01, 0.02, -0.03], R)
+    ctrl.intake.tare([0.5, -1.0, 2.0, 0.01, 0.02, -0.03], R)
     raw = [3.0, -4.0, 7.5, 0.2, -0.1, 0.05]
     code, chain = ctrl.preprocessor.process(raw, T, R)
     assert code == 0
-    assert ctrl.contact_force(raw, T, R) == pytest.approx(chain[:3], abs=1e-12)
-    assert ctrl.contact_force(np.array(raw), T.tolist(), R.tolist()) == pytest.approx(chain[:3], abs=1e-12)
+    assert ctrl.intake.contact_force(raw, T, R) == pytest.approx(chain[:3], abs=1e-12)
+    from_lists = ctrl.intake.contact_force(np.array(raw), T.tolist(), R.tolist())
+    assert from_lists == pytest.approx(chain[:3], abs=1e-12)

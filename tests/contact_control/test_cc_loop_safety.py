@@ -89,12 +89,12 @@ def test_a_spring_held_against_a_push_on_a_noisy_estimate_is_not_an_oscillation(
     estimate): velocity reversals within what that noise gives are not counted (contrast: without that
     floor the watchdog halves the gain on noise, as it did on the emulated CB3)."""
     if not noise_aware:
-        monkeypatch.setattr("contact_control.controller.WATCH_NOISE_SIGMAS", 0.0)
+        monkeypatch.setattr("contact_control.oscillation.WATCH_NOISE_SIGMAS", 0.0)
     rng = np.random.default_rng(4)
     noise = np.array([3.6, 3.6, 3.6, 0.3, 0.3, 0.3])
     loop = ClosedLoop(controller(tare_on_startup=True, lp_filter_delta_t=DT))
     loop.run(lambda t, pose: (rng.normal(size=6) * noise).tolist(), 0.4)  # zeroed: the noise floor
-    assert loop.ctrl.noise_floor is not None
+    assert loop.ctrl.intake.noise_floor is not None
     loop.start(laws(x=SPRING))
     loop.run(lambda t, pose: ([8.0, 0, 0, 0, 0, 0] + rng.normal(size=6) * noise).tolist(), 3.0)
     halved = [note for note in loop.ctrl.notes if "gain halved" in note]

@@ -22,7 +22,7 @@ def zeroed(noise=NOISE, rate=500.0, seed=1, **params):
     offset = np.array([3.0, 3.2, -18.0, 0.1, 0.2, 0.0])
     t = 0.0
     for _ in range(10000):
-        if not ctrl.zeroing:
+        if not ctrl.intake.zeroing:
             return ctrl, rng, offset, t
         ctrl.update((offset + rng.normal(size=6) * noise).tolist(), t, stamp=t)
         t += 1.0 / rate
@@ -31,7 +31,7 @@ def zeroed(noise=NOISE, rate=500.0, seed=1, **params):
 
 def test_the_noise_floor_is_measured_while_zeroing_and_reported():
     ctrl, _, _, t = zeroed()
-    floor = ctrl.noise_floor
+    floor = ctrl.intake.noise_floor
     assert floor is not None and floor.rate == pytest.approx(500.0)
     assert floor.samples >= 100 and t == pytest.approx(0.2, abs=0.01)  # 0.2 s window at 500 Hz
     np.testing.assert_allclose(floor.std, NOISE, rtol=0.2)
@@ -43,13 +43,13 @@ def test_the_noise_floor_is_measured_while_zeroing_and_reported():
 def test_a_slow_sensor_is_zeroed_over_enough_samples_to_measure_its_noise():
     ctrl, _, _, t = zeroed(noise=NOISE * 0.5, rate=30.0)
     # 25 samples, not the 6 of 0.2 s
-    assert ctrl.noise_floor.samples == 25 and t == pytest.approx(25 / 30.0, abs=0.04)
+    assert ctrl.intake.noise_floor.samples == 25 and t == pytest.approx(25 / 30.0, abs=0.04)
     assert filtered_fraction(30.0, 5.0) == pytest.approx(np.sqrt(2 * 1.1107 * 5 / 30), rel=1e-3)
 
 
 def test_a_force_limit_below_what_the_sensor_resolves_is_refused_with_the_reason_and_changes_nothing():
     ctrl, *_ = zeroed()
-    force, _ = ctrl.resolvable()
+    force, _ = ctrl.intake.resolvable()
     assert force == pytest.approx(5 * 0.63 * 0.149, rel=0.2)  # 5 filtered stds of the worst axis: ~0.47 N
     running = ctrl.set_laws(laws(x=AxisLaw(LAW_FOLLOWER, damping=30.0)), np.eye(4), 1.0)
     with pytest.raises(RequestError) as err:
@@ -124,11 +124,11 @@ def test_slow_noise_passes_the_filter_so_it_counts_whole():
     x = np.zeros(6)
     ctrl = ContactControl(load_settings({"lp_filter_delta_t": 1.0 / rate}))
     t = 0.0
-    while ctrl.zeroing and t < 5.0:
+    while ctrl.intake.zeroing and t < 5.0:
         x = a * x + np.sqrt(1 - a * a) * np.array([0.3, 0.3, 0.3, 0.03, 0.03, 0.03]) * rng.normal(size=6)
         ctrl.update(x.tolist(), t, stamp=t)
         t += 1.0 / rate
-    floor = ctrl.noise_floor
+    floor = ctrl.intake.noise_floor
     assert floor is not None
     assert np.all(np.array(floor.filtered) > 0.6 * np.array(floor.std))  # not the white-noise 0.35
 
@@ -136,14 +136,14 @@ def test_slow_noise_passes_the_filter_so_it_counts_whole():
 def test_the_zero_drift_is_measured_at_rest_and_re_tared_by_the_policy():
     for limit, retared in ((0.0, False), (2.0, True)):
         ctrl, rng, offset, t = zeroed(auto_tare_drift=limit)
-        assert ctrl.zero_drift is None
+        assert ctrl.intake.zero_drift is None
         moved = offset + np.array([3.0, -1.0, 2.0, 0.0, 0.0, 0.0])  # the zero moved 3.7 N (after a press)
         for n in range(400):  # 0.8 s at 500 Hz: not yet a whole 1 s window
             ctrl.update((moved + rng.normal(size=6) * NOISE).tolist(), t + n * 0.002, stamp=t + n * 0.002)
-        assert ctrl.zero_drift is None
+        assert ctrl.intake.zero_drift is None
         for n in range(400, 1200):
             r = ctrl.update((moved + rng.normal(size=6) * NOISE).tolist(), t + n * 0.002, stamp=t + n * 0.002)
-        drift = np.array(ctrl.zero_drift)
+        drift = np.array(ctrl.intake.zero_drift)
         if retared:
             np.testing.assert_allclose(drift[:3], 0.0, atol=0.3)  # re-tared: the next window reads ~0
             assert any("re-tared at rest: the zero had moved by 3." in note for note in ctrl.notes)  # 3.7 N
@@ -156,7 +156,7 @@ def test_the_zero_drift_is_measured_at_rest_and_re_tared_by_the_policy():
     ctrl.set_laws(laws(z=AxisLaw(LAW_FOLLOWER, damping=30.0)), np.eye(4), t)
     for n in range(1000):
         ctrl.update((offset + rng.normal(size=6) * NOISE).tolist(), t + n * 0.002, stamp=t + n * 0.002)
-    assert ctrl.zero_drift is None
+    assert ctrl.intake.zero_drift is None
 
 
 CURRENT_ESTIMATE = np.array([3.6, 3.6, 3.6, 0.3, 0.3, 0.3])  # a CB3's wrench from joint currents at 125 Hz
@@ -164,11 +164,11 @@ CURRENT_ESTIMATE = np.array([3.6, 3.6, 3.6, 0.3, 0.3, 0.3])  # a CB3's wrench fr
 
 def test_a_current_estimate_is_zeroed_with_spread_limits_from_its_own_noise():
     ctrl, _, offset, _ = zeroed(noise=CURRENT_ESTIMATE, rate=125.0)
-    floor = ctrl.noise_floor
+    floor = ctrl.intake.noise_floor
     np.testing.assert_allclose(floor.std, CURRENT_ESTIMATE, rtol=0.4)
     # The mean of the window's samples, not one of them: within 3 stds of a mean of >= 25 samples.
     assert np.all(np.abs(np.array(ctrl.preprocessor.bias) - offset) < 3 * CURRENT_ESTIMATE / 5)
-    force, _ = ctrl.resolvable()
+    force, _ = ctrl.intake.resolvable()
     assert force > 3.0  # a 0.5 N stop is refused on this sensor (runner's [CANNOT]), not left to noise
     # The fixed 4 N spread limit alone (the old rule): the window restarts on noise for ever.
     with pytest.raises(AssertionError, match=r"never zeroed.*4 N"):
@@ -186,7 +186,7 @@ def test_a_touch_among_the_first_samples_of_a_window_still_restarts_it():
     for n in range(300):
         w = offset + (touch if n < 10 else 0.0) + rng.normal(size=6) * 0.05
         messages.append(ctrl.update(w.tolist(), n * 0.002, stamp=n * 0.002).message)
-    assert not ctrl.zeroing
+    assert not ctrl.intake.zeroing
     assert any("changed by 5." in m and "tare_max_force_spread 4 N" in m for m in messages)
     np.testing.assert_allclose(ctrl.preprocessor.bias, offset, atol=0.03)
 
@@ -205,19 +205,19 @@ def test_a_tare_on_request_is_a_steady_window_again_and_giving_up_keeps_the_bias
         return out
 
     ctrl.set_laws(laws(x=AxisLaw(LAW_FOLLOWER, damping=30.0)), np.eye(4), t)
-    ctrl.start_zeroing()
+    ctrl.intake.start_zeroing()
     held = feed(50)  # 0.1 s of a 0.2 s window: the follower holds still, the bias is the old one
-    assert ctrl.zeroing and all(r.velocity == [0.0] * 6 for r in held)
+    assert ctrl.intake.zeroing and all(r.velocity == [0.0] * 6 for r in held)
     assert ctrl.preprocessor.bias == old
     feed(60)
-    assert not ctrl.zeroing and ctrl.move_active  # the move goes on with the new zero
+    assert not ctrl.intake.zeroing and ctrl.move_active  # the move goes on with the new zero
     np.testing.assert_allclose(ctrl.preprocessor.bias[:3], moved[:3], atol=0.15)
-    assert ctrl.noise_floor.samples >= 100
+    assert ctrl.intake.noise_floor.samples >= 100
     new = ctrl.preprocessor.bias
-    ctrl.start_zeroing()
+    ctrl.intake.start_zeroing()
     feed(10)
-    assert "keep the tool free" in ctrl.cancel_zeroing()
-    assert not ctrl.zeroing and ctrl.preprocessor.bias == new  # given up: nothing changed
+    assert "keep the tool free" in ctrl.intake.cancel_zeroing()
+    assert not ctrl.intake.zeroing and ctrl.preprocessor.bias == new  # given up: nothing changed
 
 
 def test_the_drift_of_a_noisy_estimate_is_measured_within_its_noise():
@@ -225,7 +225,7 @@ def test_the_drift_of_a_noisy_estimate_is_measured_within_its_noise():
     moved = offset + np.array([10.0, 0.0, 0.0, 0.0, 0.0, 0.0])
     for n in range(1, 400):  # 3.2 s at 125 Hz
         ctrl.update((moved + rng.normal(size=6) * CURRENT_ESTIMATE).tolist(), t + n / 125, stamp=t + n / 125)
-    assert ctrl.zero_drift is not None and abs(ctrl.zero_drift[0] - 10.0) < 2.5
+    assert ctrl.intake.zero_drift is not None and abs(ctrl.intake.zero_drift[0] - 10.0) < 2.5
     # Without the noise floor the watch's fixed 4 N spread never sees a steady second on this sensor.
     watch = ZeroDrift(1.0, 4.0, 0.4, spread_sigmas=8.0)
     bias = offset.tolist()
@@ -240,9 +240,9 @@ def test_the_offset_moving_with_the_pose_raises_the_smallest_limit_and_says_so(t
     """A declared pose-dependent offset (no map) or a bias map's held-out residual counts beside the noise:
     a limit the noise alone would allow is refused over the move, with that reason."""
     plain, *_ = zeroed()
-    noise_only, _ = plain.resolvable()
+    noise_only, _ = plain.intake.resolvable()
     ctrl, *_ = zeroed(pose_offset_force=0.3)
-    force, _ = ctrl.resolvable()
+    force, _ = ctrl.intake.resolvable()
     assert force == pytest.approx(np.hypot(noise_only, 5 * 0.3), rel=1e-6)  # 5 sigmas: ~1.57 N
     plain.set_laws(laws(z=AxisLaw(LAW_COMPLIANT_MOVE, velocity=-0.01, force_limit=1.0)), np.eye(4), 1.0)
     with pytest.raises(RequestError) as err:

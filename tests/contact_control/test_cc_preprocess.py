@@ -36,7 +36,7 @@ def test_tool_gravity_stays_compensated_after_reorienting(name, R):
     ctrl = controller(
         tool_mass=MASS, tool_com=COM.tolist(), follower_deadband_force=0.3, follower_deadband_torque=0.03
     )
-    ctrl.tare(sensor_reading(R_TARE).tolist(), R_TARE)
+    ctrl.intake.tare(sensor_reading(R_TARE).tolist(), R_TARE)
     ctrl.set_laws([AxisLaw(LAW_FOLLOWER, damping=30.0)] * 3 + [AxisLaw(LAW_FOLLOWER, damping=3.0)] * 3)
     for n in range(50):
         result = ctrl.update(sensor_reading(R).tolist(), n * 0.002, R_world_sensor=R)
@@ -50,7 +50,7 @@ def test_tool_gravity_stays_compensated_after_reorienting(name, R):
 def test_without_tool_model_the_same_motion_reads_a_large_force(name, R):
     # The contrast that shows the test above can fail: tare alone absorbs the weight at one orientation only.
     ctrl = controller(follower_deadband_force=0.3)
-    ctrl.tare(sensor_reading(R_TARE).tolist(), R_TARE)
+    ctrl.intake.tare(sensor_reading(R_TARE).tolist(), R_TARE)
     ctrl.update(sensor_reading(R).tolist(), 0.0, R_world_sensor=R)
     result = ctrl.update(sensor_reading(R).tolist(), 0.002, R_world_sensor=R)
     # Upside down the error is twice the weight (25.5 N) and trips the 25 N global limit instead (on the

@@ -44,8 +44,8 @@ def test_the_stale_timeout_is_ten_periods_with_a_floor(rate):
     ctrl = controller(wrench_timeout=0.1, wrench_timeout_periods=10)
     for k in range(100):
         ctrl.update([0.0] * 6, k / rate, stamp=k / rate)
-    assert ctrl.sample_period == pytest.approx(1.0 / rate)
-    assert ctrl.wrench_timeout == pytest.approx(max(0.1, 10.0 / rate))
+    assert ctrl.intake.sample_period == pytest.approx(1.0 / rate)
+    assert ctrl.intake.wrench_timeout == pytest.approx(max(0.1, 10.0 / rate))
 
 
 def test_a_212_ms_dropout_at_92_hz_halts_a_follower_and_data_resumes_it():

@@ -81,7 +81,8 @@ def test_the_offset_alone_stops_the_move_and_the_map_lets_it_run_its_travel(tmp_
     assert "travel" in why or "deviation" in why, why
     # What the map leaves counts in the smallest force limit the stack accepts.
     fitted = load_bias_map(path)
-    assert mapped.pipeline.contact.ctrl.pose_residual == (fitted.residual_force, fitted.residual_torque)
+    residual = mapped.pipeline.contact.ctrl.intake.pose_residual
+    assert residual == (fitted.residual_force, fitted.residual_torque)
 
 
 def test_a_map_of_another_frame_or_file_is_refused_before_anything_moves(tmp_path) -> None:

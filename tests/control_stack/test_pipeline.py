@@ -58,7 +58,8 @@ def test_a_stale_wrench_brings_the_arm_to_rest_and_then_silence(cell: Cell) -> N
         cell.step(None)
     moving = [t for t, v in cell.commands if t > stop and max(map(abs, v)) > 1e-9]
     last_moving = max(moving, default=stop)
-    assert last_moving - stop < cell.cc.wrench_timeout + 0.15, f"still moving {last_moving - stop:.3f} s on"
+    timeout = cell.cc.wrench_timeout
+    assert last_moving - stop < timeout + 0.15, f"still moving {last_moving - stop:.3f} s on"
     assert cell.commands[-1][1] == (0.0,) * len(cell.names), "the last command is not a full stop"
     assert cell.commands[-1][0] < cell.t - 0.1, "zero commands are still being sent: no silence after halt"
     assert cell.pipeline.contact.status()[0].safety != 0

@@ -6,7 +6,8 @@ Public API: `ContactControl` (controller), `load_settings` (parameters), `valida
 """
 
 from contact_control.axes import AXES
-from contact_control.controller import AxisState, ContactControl, CycleResult
+from contact_control.controller import ContactControl
+from contact_control.cycle import AxisState, CycleResult
 from contact_control.laws import AxisLaw
 from contact_control.params import ContactControlSettings, ParamError, load_settings
 from contact_control.request import (

@@ -12,7 +12,7 @@ import math
 from typing import NamedTuple
 
 from contact_control.axes import END_FT_VIOLATION, SAFETY_OK, SAFETY_OVER_LIMIT
-from contact_control.controller import CycleResult
+from contact_control.cycle import CycleResult
 
 __all__ = ["EVENT_NAMES", "FORCE_LIMIT", "MOVE_ENDED", "RELEASE", "TOUCH", "ContactEvent", "EventWatch"]
 

@@ -23,7 +23,7 @@ from contact_control.axes import (
     SAFETY_STALE,
     SAFETY_ZEROING,
 )
-from contact_control.controller import CycleResult
+from contact_control.cycle import CycleResult
 from contact_control.noise_floor import NoiseFloor
 from contact_control.params import ContactControlSettings
 

@@ -6,12 +6,26 @@ controller then halves that axis's gain once, and stops the move if it goes on."
 from __future__ import annotations
 
 from collections import deque
+from collections.abc import Sequence
 from dataclasses import replace
 
-from contact_control.axes import LAW_COMPLIANT_MOVE, LAW_FOLLOWER, LAW_FORCE_TRACKING, LAW_SPRING
+from contact_control.axes import (
+    AXES,
+    LAW_COMPLIANT_MOVE,
+    LAW_FOLLOWER,
+    LAW_FORCE_TRACKING,
+    LAW_NONE,
+    LAW_SPRING,
+)
 from contact_control.laws import AxisLaw
+from contact_control.noise_floor import NoiseFloor
+from contact_control.params import AxisTuning
 
-__all__ = ["OscillationWatch", "halved"]
+__all__ = ["OscillationGuard", "OscillationWatch", "halved"]
+
+#: Filtered noise stds of force a velocity reversal must exceed to count for the watchdog (noise
+#: crosses 3 stds about once in 20 independent samples: ~2 s of a 5 Hz filter's output).
+WATCH_NOISE_SIGMAS = 3.0
 
 
 class OscillationWatch:
@@ -51,3 +65,57 @@ def halved(law: AxisLaw) -> AxisLaw | None:
     if law.law == LAW_SPRING:
         return replace(law, damping=2.0 * law.damping, stiffness=0.5 * law.stiffness)
     return None
+
+
+class OscillationGuard:
+    """The watchdog over a move's axes: which velocity counts as a reversal, and what to do about one (halve
+    the gain once, then stop)."""
+
+    def __init__(self, reversals: int, window: float, tuning: Sequence[AxisTuning]) -> None:
+        self.watch = OscillationWatch(reversals, window)
+        self._halved = [False] * 6  # per axis: its gain was halved in this move
+        self._floor = [t.min_velocity for t in tuning]
+        self._seen: list[tuple[int, AxisLaw | None, str]] = []
+
+    def clear(self) -> None:
+        """A new request: nothing counted, no gain halved."""
+        self.watch.clear()
+        self._halved = [False] * 6
+
+    def set_floor(self, tuning: Sequence[AxisTuning], laws: Sequence[AxisLaw],
+                  noise: NoiseFloor | None) -> None:
+        """The velocity floor per axis: the minimum velocity, or the swing the sensor's noise alone gives a
+        law (WATCH_NOISE_SIGMAS filtered stds / b) when larger: held against a push, a law's force error
+        crosses zero with the noise and a 3.6 N estimate reversed a spring's velocity 6 times in 2 s with
+        nothing oscillating."""
+        self._floor = [t.min_velocity for t in tuning]
+        if noise is None:
+            return
+        for i, law in enumerate(laws):
+            if law.law != LAW_NONE and law.damping > 0.0:
+                std = noise.force if i < 3 else noise.torque
+                self._floor[i] = max(self._floor[i], WATCH_NOISE_SIGMAS * std / law.damping)
+
+    def check(self, t: float, velocity: Sequence[float], axes: Sequence[int], laws: Sequence[AxisLaw]
+              ) -> list[tuple[int, AxisLaw | None, str]]:
+        """The velocities commanded at `t` on `axes` under `laws`: for each axis that oscillates, (the axis,
+        its law with the gain halved or None to stop the move, what was seen in words); the check ends at a
+        stop. Usually empty (the same list, not to be kept)."""
+        seen = self._seen
+        seen.clear()
+        add, floor = self.watch.add, self._floor
+        for i in axes:
+            if not add(i, t, velocity[i], floor[i]):
+                continue
+            law = laws[i]
+            what = (f"axis {AXES[i]}: its velocity reversed {self.watch.reversals} times within "
+                    f"{self.watch.window:g} s (oscillation_reversals)")
+            lower = None if self._halved[i] else halved(law)
+            self.watch.clear(i)
+            if lower is None:
+                seen.append((i, None, f"{what}: stopped, the gain was already lowered"))
+                break
+            self._halved[i] = True
+            k = f", k {law.stiffness:g} -> {lower.stiffness:g}" if law.law == LAW_SPRING else ""
+            seen.append((i, lower, f"{what}: gain halved (b {law.damping:g} -> {lower.damping:g}{k})"))
+        return seen

@@ -37,7 +37,7 @@ from geometry_msgs.msg import TwistStamped, WrenchStamped
 from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 
 from contact_control.axes import AXES, END_NAMES, EXCEEDED_ACTION_NAMES, LAW_NAMES, SAFETY_NAMES
-from contact_control.controller import CycleResult
+from contact_control.cycle import CycleResult
 from contact_control.events import EVENT_NAMES
 from contact_control.events import ContactEvent as Event
 from contact_control.frames import matrix_quaternion, transform
@@ -291,17 +291,17 @@ class ContactControlRos:
         window without a steady one (the reason in the answer)."""
         with self._lock:
             ctrl = self._stage.ctrl
-            if ctrl.last_raw is None:
+            if ctrl.intake.last_raw is None:
                 return TriggerResponse(success=False, message="no wrench received yet: the bias is unchanged")
-            ctrl.start_zeroing()
+            ctrl.intake.start_zeroing()
             deadline = rospy.get_time() + self._s.tare_window + TARE_TIMEOUT
-            while ctrl.zeroing:
+            while ctrl.intake.zeroing:
                 if rospy.is_shutdown() or rospy.get_time() > deadline:
-                    why = ctrl.cancel_zeroing()
+                    why = ctrl.intake.cancel_zeroing()
                     return TriggerResponse(success=False, message=f"not zeroed, the bias is unchanged: {why}")
                 self._ended.wait(0.02)  # releases the lock for the wrenches being averaged
             bias = ctrl.preprocessor.bias
-            floor = ctrl.noise_floor
+            floor = ctrl.intake.noise_floor
         message = "bias [N, Nm]: " + ", ".join(f"{b:.4g}" for b in bias)
         return TriggerResponse(success=True, message=message + ("; " + floor.describe() if floor else ""))
 
@@ -360,9 +360,9 @@ class ContactControlRos:
         stage, ctrl = self._stage, self._stage.ctrl
         with self._lock:  # only the reads: the words are made outside
             r, message = stage.status()
-            last, now = ctrl.last_wrench_time, rospy.get_time()
-            period, timeout = ctrl.sample_period, ctrl.wrench_timeout
-            floor, drift = ctrl.noise_floor, ctrl.zero_drift
+            last, now = ctrl.intake.last_wrench_time, rospy.get_time()
+            period, timeout = ctrl.intake.sample_period, ctrl.intake.wrench_timeout
+            floor, drift = ctrl.intake.noise_floor, ctrl.intake.zero_drift
             master, guiding = stage.master_fault, stage.guiding
         age = None if last is None else max(0.0, now - last)
         return contact_health(self._health_name, self._s, r, message, period, age, timeout, floor, drift,
@@ -393,10 +393,10 @@ class ContactControlRos:
         for i, axis in enumerate(msg.axes):
             axis.law, axis.end_condition = r.laws[i], r.end_conditions[i]
             axis.force, axis.velocity, axis.travel = w[i], v[i], r.travel[i]
-        floor = self._stage.ctrl.noise_floor
+        floor = self._stage.ctrl.intake.noise_floor
         if floor is not None and not msg.noise_std:
             msg.noise_std, msg.noise_filtered = list(floor.std), list(floor.filtered)
-        drift = self._stage.ctrl.zero_drift
+        drift = self._stage.ctrl.intake.zero_drift
         if drift is not None:
             msg.zero_drift = list(drift)
         fill_status_words(msg, r)

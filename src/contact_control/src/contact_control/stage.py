@@ -25,7 +25,8 @@ from contact_control.axes import (
     SAFETY_NO_TF,
 )
 from contact_control.bias_map import BiasMap, BiasMapError, ResidualPredictor, load_bias_map
-from contact_control.controller import ContactControl, CycleResult
+from contact_control.controller import ContactControl
+from contact_control.cycle import CycleResult
 from contact_control.events import ContactEvent, EventWatch
 from contact_control.frames import IDENTITY, Rows, compose, inverse, rotate_twist, rotation, transpose_times
 from contact_control.laws import AxisLaw
@@ -89,7 +90,7 @@ class ContactStage:
         self.bias_map = _bias_map(s)
         if self.bias_map is not None:
             self.ctrl.preprocessor.set_load_error(self.bias_map.mass, self.bias_map.moment)
-            self.ctrl.pose_residual = (self.bias_map.residual_force, self.bias_map.residual_torque)
+            self.ctrl.intake.pose_residual = (self.bias_map.residual_force, self.bias_map.residual_torque)
         self._predict: ResidualPredictor | None = None
         self._joint_names: Sequence[str] = ()
         #: Why the bias map's offset is unknown ("": known, or no map): wrenches hold meanwhile.
@@ -231,7 +232,7 @@ class ContactStage:
         guard needs it most)."""
         if self._have_frames:
             self._have_frames = False
-            force = self.ctrl.contact_force(self._last_raw, *self._last_frames)
+            force = self.ctrl.intake.contact_force(self._last_raw, *self._last_frames)
             if force is not None:
                 self.contact = (force, self.settings.control_frame, self._last_t)
         return self.contact
@@ -241,7 +242,7 @@ class ContactStage:
         """When `tick` has work [s]: when the newest wrench turns stale, then every 1/control_rate while data
         is missing (zeros for jog_arm, the move's end after no_data_end_timeout)."""
         again = self._last_tick + self._period
-        return again if self._stale else max(self.ctrl.fresh_until, again)
+        return again if self._stale else max(self.ctrl.intake.fresh_until, again)
 
     def tick(self, t: float) -> Velocity | None:
         """The stale-data check at `t`; the twist to send, if one is due."""
@@ -359,7 +360,7 @@ class ContactStage:
         message = (f"hand-guiding on (move {move_id}): {guided} follow the "
                    f"push (b {s.guide_damping_linear:g} N/(m/s), {s.guide_damping_angular:g} Nm/(rad/s); at "
                    f"most {s.guide_max_velocity_linear:g} m/s, {s.guide_max_velocity_angular:g} rad/s)")
-        if ctrl.zeroing:
+        if ctrl.intake.zeroing:
             message += "; the sensor is still being zeroed: keep the tool free until ~status shows safety ok"
         return Answer(True, SUCCESS, message, move_id), None
 
@@ -385,7 +386,7 @@ class ContactStage:
         message = describe_laws(move_id, laws)
         if limited:
             message += "; gains lowered for the sensor's rate: " + ", ".join(limited)
-        if self.ctrl.zeroing:
+        if self.ctrl.intake.zeroing:
             message += (
                 "; the sensor is still being zeroed (at start-up or by ~tare): the laws act once ~status "
                 "shows safety ok; keep the tool free until then, a touch now would be taken as the zero"

@@ -20,7 +20,7 @@ from collections.abc import Callable, Sequence
 from typing import NamedTuple
 
 from compliant_common.clock import ClockWatch
-from contact_control.controller import CycleResult
+from contact_control.cycle import CycleResult
 from contact_control.params import ContactControlSettings
 from contact_control.request import ForceControlRequest, LawsRequest
 from contact_control.stage import ZERO, Answer, ContactStage, PoseSource, Velocity
