@@ -11,7 +11,7 @@ PYTEST_ARGS ?=
 # Test files run on this many workers (pytest-xdist, whole files per worker); 0: one process, in order.
 PYTEST_WORKERS ?= 2
 
-.PHONY: setup build test lint demo bench robot check-robot param-tables clean
+.PHONY: setup build test test-unit lint demo bench robot check-robot param-tables clean
 
 setup:
 	@scripts/bootstrap setup
@@ -28,6 +28,10 @@ test: build
 	@$(if $(filter 0,$(PYTEST_WORKERS)),true,$(ENV) python -m pytest -n $(PYTEST_WORKERS) --dist loadfile \
 		-m compute $(PYTEST_ARGS) || [ $$? -eq 5 ])
 	@$(if $(filter 0,$(PYTEST_WORKERS)),true,$(ENV) python -m pytest -m alone $(PYTEST_ARGS) || [ $$? -eq 5 ])
+
+# The tests marked `unit` (tests/conftest.py: no ROS master, no simulator, no long computation), two workers.
+test-unit: build
+	@$(ENV) python -m pytest $(if $(filter 0,$(PYTEST_WORKERS)),,-n $(PYTEST_WORKERS)) -m unit $(PYTEST_ARGS)
 
 lint: build
 	@$(ENV) ruff check src tests scripts

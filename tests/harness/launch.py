@@ -1,9 +1,12 @@
-"""Start real `roslaunch` / `rosrun` processes for a test and always stop them."""
+"""Start real `roslaunch` / `rosrun` processes for a test and always stop them; one test's processes at a
+time across the suite's workers (`process_slot`)."""
 
 from __future__ import annotations
 
 import contextlib
+import fcntl
 import os
+import pathlib
 import subprocess
 import tempfile
 import xmlrpc.client
@@ -12,7 +15,10 @@ from collections.abc import Iterator, Mapping, Sequence
 from harness.process import stop_process_group
 from harness.waiting import wait_until
 
-__all__ = ["Launched", "run_launch", "run_node"]
+__all__ = ["Launched", "process_slot", "run_launch", "run_node"]
+
+_SLOT = pathlib.Path(tempfile.gettempdir()) / "compliant_control_tests.slot"
+_slots_held = 0  # re-entry count in this process
 
 
 class _ExitedError(AssertionError):
@@ -73,7 +79,36 @@ class Launched:
 
 
 @contextlib.contextmanager
+def process_slot() -> Iterator[None]:
+    """Holds the suite's one slot for started processes (a file lock, re-entrant within a process): two
+    simulated stacks on a 2-core machine starve each other and a test then judges the load instead of the
+    stack (docs/measurements.md, *Test suite*). The other worker goes on with tests that start nothing."""
+    global _slots_held
+    if _slots_held:
+        _slots_held += 1
+        try:
+            yield
+        finally:
+            _slots_held -= 1
+        return
+    with open(_SLOT, "a") as slot:
+        fcntl.flock(slot, fcntl.LOCK_EX)
+        _slots_held = 1
+        try:
+            yield
+        finally:
+            _slots_held = 0
+            fcntl.flock(slot, fcntl.LOCK_UN)
+
+
+@contextlib.contextmanager
 def _spawn(cmd: Sequence[str], env: Mapping[str, str] | None) -> Iterator[Launched]:
+    with process_slot(), _spawned(cmd, env) as launched:
+        yield launched
+
+
+@contextlib.contextmanager
+def _spawned(cmd: Sequence[str], env: Mapping[str, str] | None) -> Iterator[Launched]:
     log = tempfile.NamedTemporaryFile(prefix="harness_", suffix=".log", delete=False)
     uri = dict(os.environ if env is None else env).get("ROS_MASTER_URI")
     before = _registered_nodes(_system_state(uri))

@@ -9,10 +9,17 @@ import subprocess
 import numpy as np
 import pytest
 from harness.bags import read_bag
+from harness.launch import process_slot
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 # The shared VM can freeze processes for 0.1-0.3 s (as in test_demos_e2e): a spoilt run is repeated.
 ATTEMPTS = 2
+
+
+def _run(command: list[str], **kwargs) -> subprocess.CompletedProcess:
+    """The demo command, holding the suite's process slot (harness.launch.process_slot) as a launch does."""
+    with process_slot():
+        return subprocess.run(command, **kwargs)
 
 
 def _demo(*args: str) -> list[str]:
@@ -28,7 +35,7 @@ def test_surface_following_through_the_emulated_ur_robot_driver_is_recorded(tmp_
                     "--output", str(tmp_path), "--bias-map", str(bias_map), "--calibration-poses", "12")
     for _ in range(ATTEMPTS):
         bias_map.unlink(missing_ok=True)
-        run = subprocess.run(command, capture_output=True, text=True, timeout=300, check=False)
+        run = _run(command, capture_output=True, text=True, timeout=300, check=False)
         if run.returncode == 0:
             break
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
@@ -47,7 +54,7 @@ def test_surface_following_through_the_emulated_ur_robot_driver_is_recorded(tmp_
 
 def test_driver_options_without_a_driver_are_refused_before_anything_launches(tmp_path):
     command = _demo("--robot", "ur5", "--driver-options", "{series: e_series}", "--output", str(tmp_path))
-    run = subprocess.run(command, capture_output=True, text=True, timeout=120, check=False)
+    run = _run(command, capture_output=True, text=True, timeout=120, check=False)
     assert run.returncode == 2
     assert "--driver-options needs --driver" in run.stderr
     assert not (tmp_path / "launch.log").exists()
@@ -64,7 +71,7 @@ def test_teach_and_replay_on_a_generated_arm(tmp_path):
 
     home = tmp_path / "home"
     command = _demo("--robot", "ur3", "--only", "teach_and_replay", "--output", str(tmp_path / "out"))
-    run = subprocess.run(command, capture_output=True, text=True, timeout=300, check=False,
+    run = _run(command, capture_output=True, text=True, timeout=300, check=False,
                          env={**os.environ, "HOME": str(home)})
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
     assert "[PASS] teach_and_replay: taught -" in run.stdout

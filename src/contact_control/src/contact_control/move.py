@@ -20,7 +20,7 @@ class MoveState:
         self.active = False
         self.id = 0
         self.t0: float | None = None  # when the move started [s] (its wait for data counts from here)
-        self.end = [END_NONE] * 6  # per axis: the condition that ended the move
+        self.end: list[int] = [END_NONE] * 6  # per axis: the condition that ended the move
         self.ended_axis = -1  # the axis that ended it, -1: none or not a single axis
         self.ok = True  # ended by an axis end condition (force limit, max travel, force jump)
         self.message = "no move yet"

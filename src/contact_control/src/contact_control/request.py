@@ -207,6 +207,168 @@ def _fields(req: ForceControlRequest, axis: int) -> tuple[int, float, float, flo
     return int(law), b, k, v, limit, travel
 
 
+class _Axis:
+    """One axis's raw request values, the checks its laws share, and how to refuse them: the field to set
+    and what it holds ("RX reads cart_impedance_params.damping.rotational.x; got 0.0")."""
+
+    def __init__(self, axis: int, fields: tuple[int, float, float, float, float, float],
+                 limits: RequestLimits, names: dict[str, str], action: int, target: float | None) -> None:
+        self.name, self.angular, self.limits, self.names = AXES[axis], axis >= 3, limits, names
+        self.law, self.b, self.k, self.v, self.limit, self.travel = fields
+        self.signed_limit = self.limit  # a compliant move without a velocity goes toward its sign
+        self.action, self.target = action, target
+        self.unit_f, self.unit_d, self.unit_v = ("Nm", "rad", "rad/s") if self.angular else ("N", "m", "m/s")
+
+    def fail(self, code: int, what: str, key: str) -> RequestError:
+        values = {"law": self.law, "b": self.b, "k": self.k, "v": self.v, "limit": self.signed_limit,
+                  "travel": self.travel, "action": self.action, "target": self.target}
+        where = f"{self.name.upper()} reads {self.names[key]}; got {values[key]}"
+        return RequestError(code, f"axis {self.name} ({LAW_NAMES.get(self.law, self.law)}): {what}; {where}",
+                            self.name)
+
+    def require(self, ok: bool, code: int, what: str, key: str) -> None:
+        if not ok:
+            raise self.fail(code, what, key)
+
+    def pick(self, linear: float | None, angular: float | None) -> float | None:
+        return angular if self.angular else linear
+
+    def check_ends(self) -> None:
+        """The force/torque limit (finite, >= 0 but for a compliant move's signed one, within the global
+        limit), the max path deviation and the exceeded action; no limit: nothing to exceed."""
+        limit, unit_f = self.limit, self.unit_f
+        signed = self.law == LAW_COMPLIANT_MOVE and self.v == 0.0
+        self.require((limit >= 0.0 or signed) and math.isfinite(limit), SET_CONTROL_FORCE_FAILED,
+                     f"force/torque limit must be finite, >= 0 {unit_f}", "limit")
+        cap = self.pick(self.limits.max_force, self.limits.max_torque)
+        self.require(cap is None or abs(limit) <= cap, SET_CONTROL_FORCE_FAILED,
+                     f"force/torque limit exceeds the global {cap} {unit_f}", "limit")
+        self.limit = abs(limit)
+        self.require(self.travel >= 0.0 and math.isfinite(self.travel), SET_CARTESIAN_CONTROL_FAILED,
+                     f"max path deviation must be finite, >= 0 {self.unit_d}", "travel")
+        self.require(self.action in EXCEEDED_ACTION_NAMES, SET_CONTROL_FORCE_FAILED,
+                     "unknown exceeded action (0 stop, 1 move_away, 2 gravity_compensation)", "action")
+        if self.limit == 0.0:
+            self.action = EXCEEDED_STOP
+
+    def damping(self, required: bool) -> float:
+        """b > 0 (`required`), else b >= 0 with no force term at 0, unless gravity compensation follows."""
+        b, finite = self.b, math.isfinite(self.b)
+        if required:
+            self.require(b > 0.0 and finite, SET_CARTESIAN_CONTROL_FAILED, "damping b must be finite and > 0",
+                         "b")
+            return b
+        self.require(b >= 0.0 and finite, SET_CARTESIAN_CONTROL_FAILED,
+                     "damping b must be finite, >= 0 (0: no force term)", "b")
+        self.require(not (self.action == EXCEEDED_GRAVITY_COMPENSATION and b == 0.0),
+                     SET_CARTESIAN_CONTROL_FAILED,
+                     "gravity_compensation makes the axis a follower (V = F / b) after its force limit: "
+                     "damping b must be > 0", "b")
+        return b
+
+    def gain(self, what: str) -> float:
+        self.require(self.k > 0.0 and math.isfinite(self.k), SET_FORCE_STIFFNESS_FAILED,
+                     f"{what} must be finite and > 0 (1/s)", "k")
+        return self.k
+
+    def law_with(self, law: int, **values: float) -> AxisLaw:
+        return AxisLaw(law, force_limit=self.limit, max_travel=self.travel, exceeded_action=self.action,
+                       **values)
+
+
+def _follower(a: _Axis) -> AxisLaw:
+    b, cap = a.damping(required=True), 0.0
+    if a.target is not None:  # ConfigureLaws: velocity caps the follower's speed (ConfigureForceControl's
+        # max_cart_vel was never read for a follower and still is not)
+        a.require(a.v >= 0.0 and math.isfinite(a.v), SET_CARTESIAN_CONTROL_FAILED,
+                  f"speed cap must be finite, >= 0 {a.unit_v} (0: none)", "v")
+        cap = a.v
+    return a.law_with(LAW_FOLLOWER, damping=b, velocity=cap)
+
+
+def _spring(a: _Axis) -> AxisLaw:
+    b = a.damping(required=True)
+    return a.law_with(LAW_SPRING, damping=b, stiffness=a.gain("stiffness k"))
+
+
+def _path(a: _Axis) -> AxisLaw:
+    k = a.gain("path gain k")
+    return a.law_with(LAW_PATH, damping=a.damping(required=False), stiffness=k)
+
+
+def _force_tracking(a: _Axis) -> AxisLaw:
+    """V = (F - target) / b: a target within the global limit and below the axis's own, an approach speed."""
+    b = a.damping(required=True)
+    assert a.target is not None  # refused before: only ConfigureLaws has the field
+    target, unit_f, unit_v = float(a.target), a.unit_f, a.unit_v
+    cap = a.pick(a.limits.max_force, a.limits.max_torque)
+    a.require(math.isfinite(target), SET_CONTROL_FORCE_FAILED, f"target force must be finite {unit_f}",
+              "target")
+    a.require(cap is None or abs(target) < cap, SET_CONTROL_FORCE_FAILED,
+              f"target force must be below the global limit {cap} {unit_f}", "target")
+    # A limit at or under the target would end the move the moment it arrived.
+    a.require(not (0.0 < a.limit <= abs(target)), SET_CONTROL_FORCE_FAILED,
+              f"force/torque limit must exceed |target_force| {abs(target):g} {unit_f} (0: no limit)",
+              "limit")
+    a.require(a.v >= 0.0 and math.isfinite(a.v), SET_CARTESIAN_CONTROL_FAILED,
+              f"approach speed must be finite, >= 0 {unit_v} (the direction is the target force's: toward "
+              "the contact; 0: the node's default)", "v")
+    v = a.v
+    if v == 0.0:
+        v = a.pick(a.limits.default_velocity, a.limits.default_angular_velocity) or 0.0
+    vmax = a.pick(a.limits.max_velocity, a.limits.max_angular_velocity)
+    a.require(vmax is None or v <= vmax, SET_CARTESIAN_CONTROL_FAILED,
+              f"approach speed exceeds max velocity {vmax} {unit_v}", "v")
+    return a.law_with(LAW_FORCE_TRACKING, damping=b, velocity=v, target=target)
+
+
+def _compliant_move(a: _Axis) -> AxisLaw:
+    """V = V_desired + F / b toward a max travel or a force limit (at least one of them)."""
+    b, unit_v = a.damping(required=False), a.unit_v
+    a.require(math.isfinite(a.v), SET_CARTESIAN_CONTROL_FAILED, f"desired velocity must be finite {unit_v}",
+              "v")
+    v = a.v
+    if v == 0.0:
+        default = a.pick(a.limits.default_velocity, a.limits.default_angular_velocity)
+        kind = "angular" if a.angular else "linear"
+        a.require(a.limit != 0.0 and default is not None, SET_CARTESIAN_CONTROL_FAILED,
+                  f"desired velocity must be non-zero {unit_v} (signed: the direction of the move)"
+                  + (f", or give a signed force/torque limit in {a.names['limit']} to approach at the node's "
+                     f"compliant_default_velocity_{kind} in its direction" if default is not None else ""),
+                  "v")
+        assert default is not None
+        v = math.copysign(default, a.signed_limit)  # toward the force limit's sign
+    vmax = a.pick(a.limits.max_velocity, a.limits.max_angular_velocity)
+    a.require(vmax is None or abs(v) <= vmax, SET_CARTESIAN_CONTROL_FAILED,
+              f"desired velocity exceeds max velocity {vmax} {unit_v}", "v")
+    vmin = a.pick(a.limits.min_velocity, a.limits.min_angular_velocity)
+    if vmin is not None and abs(v) <= vmin:
+        kind = "angular" if a.angular else "linear"
+        raise a.fail(SET_CARTESIAN_CONTROL_FAILED, f"desired velocity {abs(v):g} is not above "
+                     f"min_velocity_{kind} {vmin:g} {unit_v}: commands that slow are zeroed, the move would "
+                     "not start", "v")
+    # It would run until something else stopped it: at least one of its two end conditions.
+    a.require(a.travel != 0.0 or a.limit != 0.0, SET_CARTESIAN_CONTROL_FAILED,
+              f"needs a max path deviation > 0 or a force/torque limit > 0 (or set {a.names['travel']})",
+              "limit")
+    return a.law_with(LAW_COMPLIANT_MOVE, damping=b, velocity=v)
+
+
+#: What each law checks and builds (LAW_NONE needs nothing).
+_LAWS: dict[int, Callable[[_Axis], AxisLaw]] = {
+    LAW_FOLLOWER: _follower,
+    LAW_SPRING: _spring,
+    LAW_COMPLIANT_MOVE: _compliant_move,
+    LAW_FORCE_TRACKING: _force_tracking,
+    LAW_PATH: _path,
+}
+_LAWS_REQUEST_ONLY: dict[int, str] = {
+    LAW_PATH: "the path law (5) is offered through compliant_control_msgs/ConfigureLaws only",
+    LAW_FORCE_TRACKING: "force tracking (4) is offered through compliant_control_msgs/ConfigureLaws only "
+                        "(service configure_laws, field target_force)",
+}
+
+
 def _axis_law(
     axis: int,
     fields: tuple[int, float, float, float, float, float],
@@ -218,185 +380,19 @@ def _axis_law(
     """One axis's law from its raw values, or a RequestError naming the field to set.
 
     `target` is the force tracking target; None: the message has no such field (ConfigureForceControl), so
-    force tracking is an unknown law type there.
+    force tracking and the path law are not offered there.
     """
-    name = AXES[axis]
-    law, b, k, v, limit, travel = fields
-    angular = axis >= 3
-    unit_f, unit_d, unit_v = ("Nm", "rad", "rad/s") if angular else ("N", "m", "m/s")
-    values = {"law": law, "b": b, "k": k, "v": v, "limit": limit, "travel": travel, "action": action,
-              "target": target}
-
-    def fail(code: int, what: str, key: str) -> RequestError:
-        # The field to set and what it holds: "RX reads cart_impedance_params.damping.rotational.x; got 0.0"
-        where = f"{name.upper()} reads {names[key]}; got {values[key]}"
-        return RequestError(code, f"axis {name} ({LAW_NAMES.get(law, law)}): {what}; {where}", name)
-
-    if law == LAW_PATH and target is None:
-        raise fail(SET_DOF_FAILED, "the path law (5) is offered through compliant_control_msgs/ConfigureLaws "
-                   "only", "law")
-    if law == LAW_FORCE_TRACKING and target is None:
-        raise fail(
-            SET_DOF_FAILED,
-            "force tracking (4) is offered through compliant_control_msgs/ConfigureLaws only "
-            "(service configure_laws, field target_force)",
-            "law",
-        )
-    if law not in LAW_NAMES:
+    a = _Axis(axis, fields, limits, names, action, target)
+    if target is None and a.law in _LAWS_REQUEST_ONLY:
+        raise a.fail(SET_DOF_FAILED, _LAWS_REQUEST_ONLY[a.law], "law")
+    if a.law not in LAW_NAMES:
         known = "0 none, 1 follower, 2 spring, 3 compliant move" + (", 4 force tracking, 5 path"
                                                                      if target is not None else "")
-        raise fail(SET_DOF_FAILED, f"unknown law type {law} ({known})", "law")
-    if law == LAW_NONE:
+        raise a.fail(SET_DOF_FAILED, f"unknown law type {a.law} ({known})", "law")
+    if a.law == LAW_NONE:
         return AxisLaw()
-    signed_limit = law == LAW_COMPLIANT_MOVE and v == 0.0  # its sign gives the direction
-    if not ((limit >= 0.0 or signed_limit) and math.isfinite(limit)):
-        raise fail(SET_CONTROL_FORCE_FAILED, f"force/torque limit must be finite, >= 0 {unit_f}", "limit")
-    cap = limits.max_torque if angular else limits.max_force
-    if cap is not None and abs(limit) > cap:
-        raise fail(SET_CONTROL_FORCE_FAILED, f"force/torque limit exceeds the global {cap} {unit_f}", "limit")
-    limit = abs(limit)
-    if not (travel >= 0.0 and math.isfinite(travel)):
-        raise fail(SET_CARTESIAN_CONTROL_FAILED, f"max path deviation must be finite, >= 0 {unit_d}",
-                   "travel")
-    if action not in EXCEEDED_ACTION_NAMES:
-        raise fail(
-            SET_CONTROL_FORCE_FAILED,
-            "unknown exceeded action (0 stop, 1 move_away, 2 gravity_compensation)",
-            "action",
-        )
-    if limit == 0.0:
-        action = EXCEEDED_STOP  # nothing to exceed
-    if law in (LAW_FOLLOWER, LAW_SPRING, LAW_FORCE_TRACKING) and not (b > 0.0 and math.isfinite(b)):
-        raise fail(SET_CARTESIAN_CONTROL_FAILED, "damping b must be finite and > 0", "b")
-    if law == LAW_SPRING:
-        if not (k > 0.0 and math.isfinite(k)):
-            raise fail(SET_FORCE_STIFFNESS_FAILED, "stiffness k must be finite and > 0 (1/s)", "k")
-        return AxisLaw(
-            LAW_SPRING, damping=b, stiffness=k, force_limit=limit, max_travel=travel, exceeded_action=action
-        )
-    if law == LAW_FOLLOWER:
-        cap = 0.0
-        if target is not None:  # ConfigureLaws: velocity caps the follower's speed (ConfigureForceControl's
-            # max_cart_vel was never read for a follower and still is not)
-            if not (v >= 0.0 and math.isfinite(v)):
-                raise fail(SET_CARTESIAN_CONTROL_FAILED, f"speed cap must be finite, >= 0 {unit_v} (0: none)",
-                           "v")
-            cap = v
-        return AxisLaw(LAW_FOLLOWER, damping=b, velocity=cap, force_limit=limit, max_travel=travel,
-                       exceeded_action=action)
-    if law == LAW_PATH:
-        if not (k > 0.0 and math.isfinite(k)):
-            raise fail(SET_FORCE_STIFFNESS_FAILED, "path gain k must be finite and > 0 (1/s)", "k")
-        if not (b >= 0.0 and math.isfinite(b)):
-            raise fail(SET_CARTESIAN_CONTROL_FAILED, "damping b must be finite, >= 0 (0: no force term)", "b")
-        if action == EXCEEDED_GRAVITY_COMPENSATION and b == 0.0:
-            raise fail(SET_CARTESIAN_CONTROL_FAILED, "gravity_compensation makes the axis a follower "
-                       "(V = F / b) after its force limit: damping b must be > 0", "b")
-        return AxisLaw(LAW_PATH, damping=b, stiffness=k, force_limit=limit, max_travel=travel,
-                       exceeded_action=action)
-    if law == LAW_FORCE_TRACKING:
-        assert target is not None  # refused above
-        return _tracking_law(axis, b, v, limit, travel, action, float(target), limits, fail)
-    # compliant move
-    if not (b >= 0.0 and math.isfinite(b)):
-        raise fail(SET_CARTESIAN_CONTROL_FAILED, "damping b must be finite, >= 0 (0: no force term)", "b")
-    if action == EXCEEDED_GRAVITY_COMPENSATION and b == 0.0:
-        raise fail(
-            SET_CARTESIAN_CONTROL_FAILED,
-            "gravity_compensation makes the axis a follower (V = F / b) after its force limit: "
-            "damping b must be > 0",
-            "b",
-        )
-    if not math.isfinite(v):
-        raise fail(SET_CARTESIAN_CONTROL_FAILED, f"desired velocity must be finite {unit_v}", "v")
-    if v == 0.0:
-        default = limits.default_angular_velocity if angular else limits.default_velocity
-        if limit == 0.0 or default is None:
-            raise fail(
-                SET_CARTESIAN_CONTROL_FAILED,
-                f"desired velocity must be non-zero {unit_v} (signed: the direction of the move)"
-                + (f", or give a signed force/torque limit in {names['limit']} to approach at the node's "
-                   f"compliant_default_velocity_{'angular' if angular else 'linear'} in its direction"
-                   if default is not None else ""),
-                "v",
-            )
-        v = math.copysign(default, fields[4])  # toward the force limit's sign
-    vmax = limits.max_angular_velocity if angular else limits.max_velocity
-    if vmax is not None and abs(v) > vmax:
-        raise fail(SET_CARTESIAN_CONTROL_FAILED, f"desired velocity exceeds max velocity {vmax} {unit_v}",
-                   "v")
-    vmin = limits.min_angular_velocity if angular else limits.min_velocity
-    if vmin is not None and abs(v) <= vmin:
-        kind = "angular" if angular else "linear"
-        raise fail(SET_CARTESIAN_CONTROL_FAILED, f"desired velocity {abs(v):g} is not above "
-                   f"min_velocity_{kind} {vmin:g} {unit_v}: commands that slow are zeroed, the move would "
-                   "not start", "v")
-    if travel == 0.0 and limit == 0.0:
-        # It would run until something else stopped it: require at least one of its two end conditions.
-        raise fail(
-            SET_CARTESIAN_CONTROL_FAILED,
-            f"needs a max path deviation > 0 or a force/torque limit > 0 (or set {names['travel']})",
-            "limit",
-        )
-    return AxisLaw(
-        LAW_COMPLIANT_MOVE,
-        damping=b,
-        velocity=v,
-        force_limit=limit,
-        max_travel=travel,
-        exceeded_action=action,
-    )
-
-
-def _tracking_law(
-    axis: int,
-    b: float,
-    v: float,
-    limit: float,
-    travel: float,
-    action: int,
-    target: float,
-    limits: RequestLimits,
-    fail: Callable[[int, str, str], RequestError],
-) -> AxisLaw:
-    """The force tracking law of one axis (V = (F - target) / b), checked; `fail` builds the refusal."""
-    angular = axis >= 3
-    unit_f, unit_v = ("Nm", "rad/s") if angular else ("N", "m/s")
-    cap = limits.max_torque if angular else limits.max_force
-    if not math.isfinite(target):
-        raise fail(SET_CONTROL_FORCE_FAILED, f"target force must be finite {unit_f}", "target")
-    if cap is not None and abs(target) >= cap:
-        raise fail(SET_CONTROL_FORCE_FAILED, f"target force must be below the global limit {cap} {unit_f}",
-                   "target")
-    if limit > 0.0 and limit <= abs(target):
-        # The move would end the moment it arrived: a limit must leave room above the target.
-        raise fail(
-            SET_CONTROL_FORCE_FAILED,
-            f"force/torque limit must exceed |target_force| {abs(target):g} {unit_f} (0: no limit)",
-            "limit",
-        )
-    if not (v >= 0.0 and math.isfinite(v)):
-        raise fail(
-            SET_CARTESIAN_CONTROL_FAILED,
-            f"approach speed must be finite, >= 0 {unit_v} (the direction is the target force's: toward the "
-            "contact; 0: the node's default)",
-            "v",
-        )
-    if v == 0.0:
-        default = limits.default_angular_velocity if angular else limits.default_velocity
-        v = default if default is not None else 0.0
-    vmax = limits.max_angular_velocity if angular else limits.max_velocity
-    if vmax is not None and v > vmax:
-        raise fail(SET_CARTESIAN_CONTROL_FAILED, f"approach speed exceeds max velocity {vmax} {unit_v}", "v")
-    return AxisLaw(
-        LAW_FORCE_TRACKING,
-        damping=b,
-        velocity=v,
-        force_limit=limit,
-        max_travel=travel,
-        exceeded_action=action,
-        target=target,
-    )
+    a.check_ends()
+    return _LAWS[a.law](a)
 
 
 def _global_action(action: SimpleNamespace) -> int:
