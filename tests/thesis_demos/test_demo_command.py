@@ -66,13 +66,13 @@ def test_driver_options_without_a_driver_are_refused_before_anything_launches(tm
 def test_teach_and_replay_on_a_generated_arm(tmp_path):
     """The sixth demonstration as `make demo ROBOT=ur3` runs it: the L taught by the simulated hand is
     replayed in free space within 2 mm RMS / 5 mm max at 1 x and 2 x, and pressing on the block within
-    10 +- 1.5 N; the program lands in HOME's ~/.ros/compliant_programs."""
+    10 +- 1.5 N; the program lands in the output folder's ros_home, not in the user's ~/.ros."""
     import os
 
     home = tmp_path / "home"
     command = _demo("--robot", "ur3", "--only", "teach_and_replay", "--output", str(tmp_path / "out"))
     run = _run(command, capture_output=True, text=True, timeout=300, check=False,
-                         env={**os.environ, "HOME": str(home)})
+               env={**os.environ, "HOME": str(home)})
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
     assert "[PASS] teach_and_replay: taught -" in run.stdout
     for label in ("free space 1x", "free space 2x"):
@@ -80,6 +80,8 @@ def test_teach_and_replay_on_a_generated_arm(tmp_path):
     # Pressing at the fraction of the taught speed that makes its top speed 1 cm/s (the hand's varies).
     pressed = r"^  pressing 10 N at 0\.\d+x: program .* force \d+\.\d\d N"
     assert re.search(pressed, run.stdout, re.M), run.stdout
-    assert (home / ".ros" / "compliant_programs" / "thesis_demos_teach_and_replay.yaml").exists()
+    programs = tmp_path / "out" / "ros_home" / "compliant_programs"
+    assert (programs / "thesis_demos_teach_and_replay.yaml").exists()
+    assert not (home / ".ros" / "compliant_programs").exists()
     report = (tmp_path / "out" / "report.md").read_text()
     assert "teach_and_replay.png" in report and "free space 2x: path error max [mm]" in report
