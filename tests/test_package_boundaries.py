@@ -15,6 +15,12 @@ ADAPTER = re.compile(r"(node|.*_node|ros.*|.*client|cli|.*_cli|.*_server|.*_serv
 PACKAGES = packages()
 
 
+def _logic_importing_rospy(root):
+    """The modules under `root` that import rospy without an adapter's name."""
+    return [str(path.relative_to(root)) for path in sorted(root.rglob("*.py"))
+            if "rospy" in imported_names(path) and not ADAPTER.fullmatch(path.stem)]
+
+
 def test_every_package_is_scanned():
     assert {"compliant_common", "contact_control", "jog_arm", "mujoco_driver", "teach", "thesis_demos",
             "robot_setup", "contact_tasks"} <= set(PACKAGES)
@@ -37,9 +43,7 @@ def test_the_packages_import_one_another_without_a_cycle():
 
 @pytest.mark.parametrize("package", sorted(PACKAGES))
 def test_only_adapters_import_rospy(package):
-    root = PACKAGES[package]
-    logic = [str(path.relative_to(root)) for path in sorted(root.rglob("*.py"))
-             if "rospy" in imported_names(path) and not ADAPTER.fullmatch(path.stem)]
+    logic = _logic_importing_rospy(PACKAGES[package])
     assert logic == [], f"{package}: rospy imported outside node, ros_*, *client, cli, *_server, *_service"
 
 
@@ -91,6 +95,4 @@ def test_rospy_in_a_logic_module_is_found(tmp_path):
     (package / "__init__.py").write_text("")
     (package / "laws.py").write_text("def f():\n    import rospy.timer\n")
     (package / "ros_io.py").write_text("import rospy\n")
-    found = [p.stem for p in sorted(package.glob("*.py"))
-             if "rospy" in imported_names(p) and not ADAPTER.fullmatch(p.stem)]
-    assert found == ["laws"]
+    assert _logic_importing_rospy(package) == ["laws.py"]

@@ -400,9 +400,7 @@ class ContactControl:
 
     def _step_velocities(self, t: float, w: list[float]) -> None:
         """Each active axis's law, then its velocity shaped by the rate limits over the cycle's dt."""
-        last = self._last_t
-        dt = self._dt_nominal if last is None else min(max(t - last, 0.0), self.intake.wrench_timeout)
-        self._last_t = t
+        dt = self._cycle_dt(t)
         c, v, tuning, travel = self._set, self._v, self._tuning, self._travel
         error, reference, fast = self._path_error, self._path_velocity, self.preprocessor.fast
         for i in c.active:
@@ -413,6 +411,11 @@ class ContactControl:
                 if c.guarded[i]:
                     target = guard_pressing(c.laws[i], tuning[i], target, fast[i])
             v[i] = shape_velocity(target, v[i], tuning[i], dt, c.floor[i])
+
+    def _cycle_dt(self, t: float) -> float:
+        """Time since the last cycle that moved the axes (nominal after a hold), at most the stale timeout."""
+        last, self._last_t = self._last_t, t
+        return self._dt_nominal if last is None else min(max(t - last, 0.0), self.intake.wrench_timeout)
 
     def _watch_oscillation(self, t: float) -> CycleResult | None:
         """The watchdog (oscillation.OscillationGuard): an oscillating axis's gain is halved once (the move
@@ -522,10 +525,7 @@ class ContactControl:
 
     def _react(self, t: float, w: list[float]) -> CycleResult:
         """A cycle of the exceeded actions after the move ended (`exceeded.ExceededReaction`)."""
-        last = self._last_t
-        dt = self._dt_nominal if last is None else min(max(t - last, 0.0), self.intake.wrench_timeout)
-        self._last_t = t
-        self._reaction.step(w, self._v, dt)
+        self._reaction.step(w, self._v, self._cycle_dt(t))
         return self._result(t, SAFETY_OK, "")
 
     def _stop_reaction(self, reason: str) -> bool:
