@@ -19,7 +19,8 @@ pytest_plugins = ["harness.fixtures"]
 from harness.launch import process_slot  # noqa: E402 (after the path set-up above)
 
 # Tiers (pytest.ini): `e2e` for a test on a ROS master (the roscore fixture), a simulator (a module importing
-# mujoco or mujoco_driver) or minutes of computation (`compute`); `unit` for the rest (`make test-unit`).
+# mujoco or mujoco_driver), minutes of computation (`compute`, `alone`) or marked `e2e` itself (a test that runs
+# a simulation in a subprocess); `unit` for the rest (`make test-unit`).
 _SIMULATOR = re.compile(r"^\s*(?:import|from)\s+mujoco", re.MULTILINE)
 
 
@@ -29,9 +30,10 @@ def pytest_collection_modifyitems(config, items):
         path = str(item.path)
         if path not in simulated:
             simulated[path] = bool(_SIMULATOR.search(item.path.read_text()))
-        e2e = "roscore" in getattr(item, "fixturenames", ()) or simulated[path] or \
-            item.get_closest_marker("compute") is not None
-        item.add_marker(pytest.mark.e2e if e2e else pytest.mark.unit)
+        marked = any(item.get_closest_marker(name) is not None for name in ("e2e", "compute", "alone"))
+        e2e = marked or "roscore" in getattr(item, "fixturenames", ()) or simulated[path]
+        if not item.get_closest_marker("e2e"):
+            item.add_marker(pytest.mark.e2e if e2e else pytest.mark.unit)
 
 
 @pytest.fixture(autouse=True)

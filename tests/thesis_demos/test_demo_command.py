@@ -27,6 +27,7 @@ def _demo(*args: str) -> list[str]:
     return [str(ROOT / "scripts/with_env"), "python", str(ROOT / "scripts/demo"), *args]
 
 
+@pytest.mark.e2e  # scripts/demo runs the simulation
 def test_surface_following_through_the_emulated_ur_robot_driver_is_recorded(tmp_path):
     """Surface following against the 125 Hz driver holds 10 +- 1.5 N over the slide (it failed at 5.9-12.3 N
     while the simulated tool hopped on the block), and the bag holds the driver's wrench at its rate."""
