@@ -19,8 +19,8 @@ pytest_plugins = ["harness.fixtures"]
 from harness.launch import process_slot  # noqa: E402 (after the path set-up above)
 
 # Tiers (pytest.ini): `e2e` for a test on a ROS master (the roscore fixture), a simulator (a module importing
-# mujoco or mujoco_driver), minutes of computation (`compute`, `alone`) or marked `e2e` itself (a test that runs
-# a simulation in a subprocess); `unit` for the rest (`make test-unit`).
+# mujoco or mujoco_driver), minutes of computation (`compute`, `alone`) or marked `e2e` itself (a test that
+# runs a simulation in a subprocess); `unit` for the rest (`make test-unit`).
 _SIMULATOR = re.compile(r"^\s*(?:import|from)\s+mujoco", re.MULTILINE)
 
 

@@ -93,6 +93,58 @@ def test_a_reference_that_stops_coming_stops_the_tool_near_its_last_point():
     assert past < speed * 0.05 + 1e-3, f"{past * 1e3:.1f} mm past the last reference"
 
 
+def test_a_stalled_reference_with_a_horizon_is_followed_along_it_then_stands_at_its_end():
+    """The same 0.1 m/s stream with 0.3 s of horizon (a pose every 20 ms, turning about Z at 0.2 rad/s): a
+    0.2 s stall keeps the tool moving on the path (it stopped without one, above); a 0.4 s stall ends at the
+    horizon's last pose, not v / k past it."""
+    ctrl = controller(lp_filter_enabled=False, acceleration_linear=2.5, deceleration_linear=2.5)
+    loop = ClosedLoop(ctrl, lag=0.02)
+    speed, turn, step = 0.1, 0.2, 0.02
+
+    def pose_at(t):
+        return (speed * t, 0.0, 0.0), (0.0, 0.0, np.sin(turn * t / 2), np.cos(turn * t / 2))
+
+    def send(t):
+        p, q = pose_at(t)
+        horizon = [pose_at(t + (j + 1) * step) for j in range(15)]
+        assert ctrl.set_path_reference(p, q, (speed, 0, 0, 0, 0, turn), t, horizon, step) == ""
+
+    def until(stop: float):
+        def wrench(t, pose):
+            if t < stop:
+                send(t)
+            return (0.0,) * 6
+        return wrench
+
+    send(0.0)
+    loop.start(laws(x=AxisLaw(LAW_PATH, stiffness=5.0), y=AxisLaw(LAW_PATH, stiffness=5.0),
+                    z=AxisLaw(LAW_PATH, stiffness=5.0), rz=AxisLaw(LAW_PATH, stiffness=5.0)))
+    loop.run(until(1.0), 1.0)
+    result = loop.run(until(1.0), 0.2)  # stalled: the horizon carries the reference on
+    assert result.move_active
+    assert loop.pose[0, 3] == pytest.approx(speed * loop.t, abs=3e-3)
+    assert result.velocity[0] == pytest.approx(speed, abs=0.01)
+    assert result.velocity[5] == pytest.approx(turn, abs=0.05)
+    loop.run(until(1.0), 0.3)  # past the horizon (0.3 s): stands at its last pose
+    end = speed * (1.0 + 15 * step)
+    assert loop.pose[0, 3] == pytest.approx(end, abs=2e-3)
+    assert np.arctan2(loop.pose[1, 0], loop.pose[0, 0]) == pytest.approx(turn * (1.0 + 15 * step), abs=0.02)
+
+
+def test_a_bad_horizon_is_refused_and_changes_nothing():
+    ctrl = controller(lp_filter_enabled=False)
+    assert ctrl.set_path_reference((0, 0, 0), (0, 0, 0, 1), (0,) * 6, 0.0) == ""
+    ahead = [((0.01, 0, 0), (0, 0, 0, 1))]
+    assert "horizon_step > 0" in ctrl.set_path_reference((1, 0, 0), (0, 0, 0, 1), (0,) * 6, 0.1, ahead, 0.0)
+    assert "unit quaternion" in ctrl.set_path_reference((1, 0, 0), (0, 0, 0, 1), (0,) * 6, 0.1,
+                                                        [((0, 0, 0), (0, 0, 0, 2))], 0.02)
+    assert "finite" in ctrl.set_path_reference((1, 0, 0), (0, 0, 0, 1), (0,) * 6, 0.1,
+                                               [((np.nan, 0, 0), (0, 0, 0, 1))], 0.02)
+    error, velocity = [0.0] * 6, [0.0] * 6
+    assert ctrl._path.error(0.01, np.eye(4), None, error, velocity)
+    assert error == [0.0] * 6  # still the first reference, at the origin
+
+
 def test_the_move_ends_when_the_reference_stops_coming_or_the_error_grows_too_large():
     ctrl = controller(lp_filter_enabled=False, path_reference_timeout=0.1)
     loop = ClosedLoop(ctrl)

@@ -181,6 +181,25 @@ def test_playback_follows_the_waypoints_in_time_and_its_clock_pauses_and_slows()
     assert d == pytest.approx([0.002, 0.003, 0.1])
 
 
+def test_the_horizon_is_where_the_reference_will_be_and_holds_while_paused_and_at_the_end():
+    from teach.playback import Playback
+
+    play = Playback(recorded(), speed=2.0)
+    play.advance(1.0, rate=0.5)
+    ahead = play.horizon(0.1, 4)
+    for j, (p, q) in enumerate(ahead, start=1):
+        later = Playback(recorded(), speed=2.0)
+        later.advance(1.0 + j * 0.1, rate=0.5)  # the same clock, on at the same rate
+        p_ref, q_ref, _ = later.reference()
+        assert p == pytest.approx(p_ref) and q == pytest.approx(q_ref)
+    assert ahead[-1][0][0] > ahead[0][0][0]  # it moves on along the first leg
+    play.paused = True
+    assert all(p == pytest.approx(play.reference()[0]) for p, _ in play.horizon(0.1, 4))
+    play.paused = False
+    play.advance(100.0)
+    assert all(p == pytest.approx(play.reference()[0]) for p, _ in play.horizon(0.1, 4))
+
+
 def test_a_replay_faster_than_the_arm_is_slowed_to_its_limits_before_it_starts():
     from teach.playback import Playback
     from teach.timing import Limits, replay_times

@@ -243,10 +243,12 @@ class ContactControl:
         return self._move.change()
 
     def set_path_reference(self, position: Sequence[float], quaternion: Sequence[float],
-                           twist: Sequence[float], t: float) -> str:
-        """The path law's reference at time `t` [s] (fixed frame; see `path_ref.PathReference.set`): '' or why
-        it is refused."""
-        return self._path.set(position, quaternion, twist, t)
+                           twist: Sequence[float], t: float,
+                           horizon: Sequence[tuple[Sequence[float], Sequence[float]]] = (),
+                           step: float = 0.0) -> str:
+        """The path law's reference at time `t` [s] and its horizon (fixed frame; see
+        `path_ref.PathReference.set`): '' or why it is refused."""
+        return self._path.set(position, quaternion, twist, t, horizon, step)
 
     def clock_jumped(self, t: float, description: str) -> CycleResult:
         """The clock jumped (see compliant_common.clock): every duration measured across it is wrong, so the

@@ -3,9 +3,11 @@ replay.
 
 V = v_ref + k e (+ F / b): `PathReference.error` gives, per control axis, the pose error e (reference minus
 end effector: position [m], rotation vector [rad]) and v_ref, both along the control axes. The reference is
-held for `timeout` after its stamp: for `extrapolate` s its position moves on with its velocity, then it
+held for `timeout` after its stamp: for `extrapolate` s its position moves on with its velocity; then, if it
+came with a horizon (where it will be every `step` s after), it follows the horizon to its end, and then it
 stands still (no velocity fed forward); an older one is lost, and the move ends (the replay stopped
-sending). No ROS here.
+sending). A horizon lets a late sender (a stalled replay) keep the tool on its path instead of stopping it
+(teach's README, *Replay*). No ROS here.
 """
 
 from __future__ import annotations
@@ -37,6 +39,9 @@ class PathReference:
         self._p = (0.0, 0.0, 0.0)
         self._r: list[list[float]] = [list(row) for row in _IDENTITY]
         self._v = (0.0,) * 6
+        self._step = 0.0
+        self._ahead: list[tuple[tuple[float, ...], tuple[float, ...]]] = []  # (position, quaternion)
+        self._q = (0.0, 0.0, 0.0, 1.0)
 
     @property
     def received(self) -> bool:
@@ -46,20 +51,53 @@ class PathReference:
         self._t = None
 
     def set(self, position: Sequence[float], quaternion: Sequence[float], twist: Sequence[float],
-            t: float) -> str:
+            t: float, horizon: Sequence[tuple[Sequence[float], Sequence[float]]] = (),
+            step: float = 0.0) -> str:
         """A new reference at time `t` [s]: position [m], quaternion (x, y, z, w), twist (vx..wz) [m/s, rad/s]
-        in the fixed frame. Returns '' or why it is refused (not finite, not a rotation)."""
+        in the fixed frame, and its horizon: (position, quaternion) `step`, 2 `step`, ... [s] after. Returns
+        '' or why it is refused (not finite, not a rotation, a horizon without a positive step); a refused
+        reference changes nothing."""
         values = (*position, *quaternion, *twist, t)
         sizes = (len(position), len(quaternion), len(twist))
         if sizes != (3, 4, 6) or not all(map(math.isfinite, values)):
             return "path reference: expected finite position (3), quaternion (4) and twist (6)"
         if abs(sum(q * q for q in quaternion) - 1.0) > 0.01:
             return "path reference: the quaternion is not a unit quaternion"
+        if horizon:
+            if not (math.isfinite(step) and step > 0.0):
+                return f"path reference: a horizon needs horizon_step > 0, got {step}"
+            for p, q in horizon:
+                if len(p) != 3 or len(q) != 4 or not all(map(math.isfinite, (*p, *q))):
+                    return "path reference: expected finite positions (3) and quaternions (4) in the horizon"
+                if abs(sum(c * c for c in q) - 1.0) > 0.01:
+                    return "path reference: a horizon quaternion is not a unit quaternion"
         self._p = (float(position[0]), float(position[1]), float(position[2]))
+        self._q = (float(quaternion[0]), float(quaternion[1]), float(quaternion[2]), float(quaternion[3]))
         self._r = quaternion_matrix(*quaternion)
         self._v = tuple(float(x) for x in twist)  # type: ignore[assignment]
+        self._ahead = [(tuple(p), tuple(q)) for p, q in horizon]
+        self._step = float(step)
         self._t = t
         return ""
+
+    def _along_horizon(self, age: float) -> tuple[tuple[float, ...], list[list[float]], tuple[float, ...]]:
+        """Position, rotation and twist `age` s after the reference, between the horizon's poses (position
+        linear, orientation normalised-linear: a step's rotation is small); past its end it stands still."""
+        poses = [(self._p, self._q), *self._ahead]
+        k = int(age / self._step)
+        if k >= len(poses) - 1:
+            p, q = poses[-1]
+            return p, quaternion_matrix(*q), (0.0,) * 6
+        s = age / self._step - k
+        (p0, q0), (p1, q1) = poses[k], poses[k + 1]
+        sign = 1.0 if sum(a * b for a, b in zip(q0, q1, strict=True)) >= 0.0 else -1.0
+        mid = [(1.0 - s) * a + s * sign * b for a, b in zip(q0, q1, strict=True)]
+        r0, r1 = quaternion_matrix(*q0), quaternion_matrix(*q1)
+        turn = [[sum(r1[i][n] * r0[j][n] for n in range(3)) for j in range(3)] for i in range(3)]  # R1 R0^T
+        w = rotation_vector(turn)
+        step = self._step
+        v = tuple((p1[i] - p0[i]) / step for i in range(3)) + tuple(x / step for x in w)
+        return tuple(a + s * (b - a) for a, b in zip(p0, p1, strict=True)), quaternion_matrix(*mid), v
 
     def age(self, t: float) -> float:
         return math.inf if self._t is None else t - self._t
@@ -72,11 +110,15 @@ class PathReference:
             return False
         m = as_rows(T_fixed_eef)
         age = max(t - self._t, 0.0)
-        dt = min(age, self.extrapolate)
-        p, r = self._p, self._r
-        # Past `extrapolate` the reference stands still: fed forward on, its velocity carried the tool v / k
-        # past the last point (a stalled replay ran a UR3 12 mm past the L's corner).
-        v = self._v if age <= self.extrapolate else (0.0,) * 6
+        if age > self.extrapolate and self._ahead:
+            p, r, v = self._along_horizon(age)
+            dt = 0.0
+        else:
+            dt = min(age, self.extrapolate)
+            p, r = self._p, self._r
+            # Past `extrapolate` the reference stands still: fed forward on, its velocity carried the tool
+            # v / k past the last point (a stalled replay ran a UR3 12 mm past the L's corner).
+            v = self._v if age <= self.extrapolate else (0.0,) * 6
         e = [p[i] + v[i] * dt - m[i][3] for i in range(3)]
         # R_ref R_eef^T: the rotation still to go, in the fixed frame.
         rd = [[r[i][0] * m[j][0] + r[i][1] * m[j][1] + r[i][2] * m[j][2] for j in range(3)] for i in range(3)]

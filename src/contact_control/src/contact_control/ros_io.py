@@ -257,9 +257,13 @@ class ContactControlRos:
                                    frame, self._s.fixed_frame)
             return
         p, q, v, w = msg.pose.position, msg.pose.orientation, msg.velocity.linear, msg.velocity.angular
+        horizon = [((h.position.x, h.position.y, h.position.z),
+                    (h.orientation.x, h.orientation.y, h.orientation.z, h.orientation.w))
+                   for h in msg.horizon]
         with self._lock:
             why = self._stage.ctrl.set_path_reference((p.x, p.y, p.z), (q.x, q.y, q.z, q.w),
-                                                      (v.x, v.y, v.z, w.x, w.y, w.z), rospy.get_time())
+                                                      (v.x, v.y, v.z, w.x, w.y, w.z), rospy.get_time(),
+                                                      horizon, msg.horizon_step)
         if why:
             rospy.logwarn_throttle(5.0, "contact_control: %s", why)
 

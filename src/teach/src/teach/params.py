@@ -43,6 +43,15 @@ class TeachSettings:
     replay_rate: float = param(
         100.0, unit="Hz", gt=0.0, le=1000.0, doc="rate of the path reference streamed to contact_control"
     )
+    replay_horizon: float = param(
+        0.4, unit="s", ge=0.0, le=2.0,
+        doc="each path reference carries where the path goes this far ahead, which contact_control "
+        "follows when the stream is late, so a stall of the replay does not stop the tool; also the most "
+        "the program's clock moves on after a stall. 0: none",
+    )
+    replay_horizon_step: float = param(
+        0.02, unit="s", gt=0.0, doc="the time between the horizon's poses"
+    )
     replay_max_speed: float = param(4.0, gt=0.0, doc="the largest speed factor a replay accepts")
     replay_gain: float = param(
         5.0, unit="1/s", gt=0.0,

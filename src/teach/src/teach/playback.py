@@ -121,6 +121,18 @@ class Playback:
             twist[:] = self._deltas[i] / span * self.rate
         return p, q, twist
 
+    def horizon(self, step: float, count: int) -> list[tuple[FloatArray, tuple[float, float, float, float]]]:
+        """Where the reference will be `step`, 2 `step`, ... `count` `step` [s] from now, the clock running on
+        at its last rate (paused: where it is; it stops at the end): contact_control follows these when the
+        stream is late."""
+        ahead = 0.0 if self.paused else step * self.rate
+        out = []
+        for j in range(1, count + 1):
+            clock = min(self.clock + j * ahead, self.planned)
+            p, q, _ = interpolate(self._t, self._p, self._q, float(np.interp(clock, self._r, self._t)))
+            out.append((p, q))
+        return out
+
 
 def path_distance(points: FloatArray, path: FloatArray) -> FloatArray:
     """Distance [m] of each point (n, 3) from the polyline `path` (m, 3): the shortest to any segment."""

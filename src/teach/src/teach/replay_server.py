@@ -30,6 +30,7 @@ from compliant_control_msgs.msg import (
 )
 from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsRequest, MoveToJoints
 from contact_control.params import ParamError, load_settings
+from geometry_msgs.msg import Pose
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 
@@ -77,8 +78,9 @@ class ReplayServer:
         self._events: list[ContactEvent] = []
         self._lock = threading.Lock()
         self._playback: Playback | None = None
-        self._ref = PathReference()
+        self._ref = PathReference(horizon_step=s.replay_horizon_step)
         self._ref.header.frame_id = base_frame
+        self._ref.horizon = [Pose() for _ in range(round(s.replay_horizon / s.replay_horizon_step))]
         self._server = actionlib.SimpleActionServer("~replay", ReplayProgramAction, self._execute,
                                                     auto_start=False)
         self._services = [rospy.Service("~pause", Trigger, self._on_pause),
@@ -226,6 +228,9 @@ class ReplayServer:
         ori.x, ori.y, ori.z, ori.w = q
         lin, ang = ref.velocity.linear, ref.velocity.angular
         lin.x, lin.y, lin.z, ang.x, ang.y, ang.z = (float(x) for x in v)
+        for pose, (p, q) in zip(ref.horizon, play.horizon(ref.horizon_step, len(ref.horizon)), strict=True):
+            pose.position.x, pose.position.y, pose.position.z = (float(x) for x in p)
+            pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w = q
         self._ref_pub.publish(ref)
 
     def _replay(self, goal: ReplayProgramGoal) -> ReplayProgramResult:
@@ -272,8 +277,9 @@ class ReplayServer:
         try:
             while not rospy.is_shutdown():
                 now = rospy.get_time()
-                # A clock jump (or a stall) moves the program's clock by one cycle at most, never backwards.
-                dt, last = min(max(now - last, 0.0), 2.0 / s.replay_rate), now
+                # A stall moves the program's clock on as far as the horizon that contact_control followed
+                # meanwhile, a clock jump no further; never backwards.
+                dt, last = min(max(now - last, 0.0), max(2.0 / s.replay_rate, s.replay_horizon)), now
                 if self._server.is_preempt_requested():
                     return self._ended(False, f"cancelled at {play.progress:.0%}", distances, forces)
                 status = self._status
