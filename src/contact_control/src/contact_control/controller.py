@@ -1,57 +1,23 @@
-"""ContactControl: wrench preprocessing plus the six axis laws, one `update` per wrench.
+"""ContactControl: wrench preprocessing plus the six axis laws, one `update` per wrench (no ROS here).
 
-Decisions (the README repeats them):
-- A move runs from `set_laws` until any active axis meets an end condition (force/torque limit, max travel,
-  force jump), `stop()`, a new request, a global-limit trip or prolonged missing data; then every axis holds
-  still (zero velocity) and the result says which axis and condition ended it.
-- NaN/inf wrench: zero output in that same cycle (SAFETY_NAN); the move resumes with the next valid wrench.
-- Stale wrench (none for `wrench_timeout`, or a header stamp older than that): zero output (SAFETY_STALE) from
-  `check_stale`, which the node calls once the data is due to turn stale (`intake.fresh_until`); after
-  `no_data_end_timeout` the move ends (NO_FT_DATA).
-- Wrench over `global_max_force`/`global_max_torque`: zero output, the move ends (FT_VIOLATION on its active
-  axes) and the safety stays latched, refusing new laws, until `reset_safety()`.
-- After any pause the velocity restarts from zero under the acceleration limit.
-- A move that ended on a force/torque limit hands over to the axes' exceeded actions (`exceeded`): move away
-  from the contact or gravity compensation. Twists keep coming while one runs (`CycleResult.commanding`).
+How a move starts, ends and resumes after NaN, stale or over-limit data: the package README, *Moves and how
+they end* and *Safety*. A move that ended on a force limit hands over to its axes' exceeded actions
+(`exceeded`); twists keep coming while one runs (`CycleResult.commanding`).
 
 Not thread-safe: the node serialises calls with one lock.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
-from contact_control.axes import (
-    AXES,
-    END_DIFF_VIOLATION,
-    END_EXTERNAL_STOP,
-    END_FT_VIOLATION,
-    END_MAX_TRAVEL,
-    END_NAMES,
-    END_NO_FT_DATA,
-    END_OSCILLATION,
-    END_PATH_ERROR,
-    END_PATH_LOST,
-    LAW_FOLLOWER,
-    SAFETY_NAN,
-    SAFETY_OK,
-    SAFETY_OVER_LIMIT,
-    SAFETY_STALE,
-)
+from contact_control.axes import End, Law, Safety
 from contact_control.cycle import CycleResult
+from contact_control.ends import EndChecks, end_reason
 from contact_control.exceeded import ExceededReaction
 from contact_control.intake import WrenchIntake
 from contact_control.law_set import LawSet
-from contact_control.laws import (
-    AxisLaw,
-    ForceWindow,
-    check_end,
-    guard_pressing,
-    law_velocity,
-    path_velocity,
-    shape_velocity,
-)
+from contact_control.laws import AxisLaw, guard_pressing, law_velocity, path_velocity, shape_velocity
 from contact_control.loop_gain import GainBound
 from contact_control.move import MoveState
 from contact_control.oscillation import OscillationGuard
@@ -59,10 +25,9 @@ from contact_control.params import ContactControlSettings
 from contact_control.path_ref import PathReference
 from contact_control.preprocess import Matrix
 from contact_control.request import FAILURE, RequestError
-from contact_control.travel import TravelMeter
+from contact_control.travel import MoveTravel
 
 __all__ = ["ContactControl"]
-
 
 
 class ContactControl:
@@ -82,15 +47,9 @@ class ContactControl:
         self._tuning = tuple(s.tuning(i >= 3) for i in range(6))
         self._end_timeout = s.no_data_end_timeout
         self._dt_nominal = 1.0 / s.control_rate
-        self._diff = tuple(t.diff_max for t in self._tuning)
-        self._windows = [ForceWindow(s.diff_window) for _ in range(6)]
-        # The tool's own inertia while the axes speed up from rest reads as force on a wrist sensor (1 kg
-        # at 0.5 m/s^2 is 0.5 N), so force limits are checked from force_limit_arm_time after a start.
-        self._arm_time = s.force_limit_arm_time
-        self._armed = [True] * 6
-        self._from_rest: float | None = None  # when the axes last started from rest
-        self._meter = TravelMeter(s.travel_directions)
-        self._travel_offset = [0.0] * 6  # travel of an axis whose law changed during a move, at the change
+        self._ends = EndChecks(tuple(t.diff_max for t in self._tuning), s.diff_window, s.force_limit_arm_time,
+                               int(s.force_limit_samples))
+        self._moved = MoveTravel(s.travel_directions)
         self._reaction = ExceededReaction(self._tuning, s.move_away_release_fraction)
         self._set = LawSet()
         self._shown = list(self._set.types)  # the law each axis runs now (gravity compensation: follower)
@@ -98,19 +57,17 @@ class ContactControl:
         self._path_error = [0.0] * 6
         self._path_velocity = [0.0] * 6
         self._v = [0.0] * 6
-        self._travel = [0.0] * 6
         self._wrench = [0.0] * 6
         self._move = MoveState()
         self._last_t: float | None = None
         self._gain_bound = GainBound(s.loop_gain_delay, s.command_latency, s.spring_output_scale,
                                      s.contact_stiffness)
         self._limit_samples = int(s.force_limit_samples)
-        self._over = [0] * 6  # per axis: wrenches in a row over its force limit
         self._over_global = 0  # wrenches in a row over a global limit
         self._watch = (OscillationGuard(int(s.oscillation_reversals), s.oscillation_window, self._tuning)
                        if s.oscillation_reversals > 0 else None)
         self._requested: list[AxisLaw] = []  # the laws as last requested (the watchdog may lower them)
-        self.last_result = self._result(0.0, SAFETY_STALE, "no wrench yet")
+        self.last_result = self._result(0.0, Safety.STALE, "no wrench yet")
 
     # --- state ---
     @property
@@ -155,10 +112,6 @@ class ContactControl:
         cutoff = self.preprocessor.cutoff if self.settings.lp_filter_enabled else None
         return self._gain_bound.limit(laws, period, cutoff)
 
-    @property
-    def safety_latched(self) -> bool:
-        return self._move.latched
-
     # --- commands ---
     def set_laws(
         self,
@@ -193,31 +146,24 @@ class ContactControl:
         self._requested = laws
         if self.intake.drift is not None:
             self.intake.drift.restart()
-        self._over = [0] * 6
+        self._ends.clear_over()
         if self._watch is not None:
             self._watch.clear()
         if self._move.active and any(law.law for law in laws):
             return self._change_laws(laws, t)
         if self._move.active:
-            self._end_move(-1, END_EXTERNAL_STOP, False, "replaced by a new request")
-        self._travel_offset = [0.0] * 6
+            self._end_move(-1, End.EXTERNAL_STOP, False, "replaced by a new request")
         self._reaction.clear()
         self._adopt(laws)
-        for window in self._windows:
-            window.clear()
+        self._ends.restart(t)
         self._v = [0.0] * 6
-        self._armed = [self._arm_time <= 0.0] * 6
-        self._from_rest = t
-        self._travel = [0.0] * 6
+        self._moved.restart(eef_pose, R_fixed_control)
         self._last_t = None
-        self._meter.clear()
-        if eef_pose is not None:
-            self._meter.start(eef_pose, R_fixed_control)
         return self._move.begin(bool(self._set.active), t)
 
     def _adopt(self, laws: list[AxisLaw]) -> None:
         """Six laws compiled for the cycles (a new move's or a changed one's)."""
-        self._set = LawSet.of(laws, self._diff, self.settings.force_tracking_fast_guard)
+        self._set = LawSet.of(laws, self._ends.diff, self.settings.force_tracking_fast_guard)
         self._shown = list(self._set.types)
         self.preprocessor.keep_fast = any(self._set.guarded)
         self._watch_floor_update()
@@ -228,17 +174,14 @@ class ContactControl:
         an axis whose law changes starts from rest, its travel from here. The move gets a new id (a blocking
         caller of the old request is answered), but nothing stops."""
         old, kept = self._set.types, list(self._v)
-        self._end_move(-1, END_EXTERNAL_STOP, False, "changed by a new request")
+        self._end_move(-1, End.EXTERNAL_STOP, False, "changed by a new request")
         self._v = kept
         for i, law in enumerate(laws):
             if law.law != old[i] or not law.law:
                 self._v[i] = 0.0
-                self._travel_offset[i] = self._travel[i] + self._travel_offset[i]
-                self._travel[i] = 0.0
-                self._windows[i].clear()
-                self._armed[i] = self._arm_time <= 0.0
-        if not all(self._armed):
-            self._from_rest = t
+                self._moved.restart_axis(i)
+                self._ends.restart_axis(i)
+        self._ends.started(t)
         self._adopt(laws)
         return self._move.change()
 
@@ -258,15 +201,14 @@ class ContactControl:
         self._last_t = None
         if self._move.active:
             self._move.t0 = t
-        for window in self._windows:
-            window.clear()
-        return self._hold(t, SAFETY_STALE, f"{description}: timing reset, holding until fresh data")
+        self._ends.clear_windows()
+        return self._hold(t, Safety.STALE, f"{description}: timing reset, holding until fresh data")
 
     def stop(self, reason: str = "stop requested") -> bool:
         """Ends the running move (EXTERNAL_STOP) or exceeded action; returns whether one was running."""
         if not self._move.active:
             return self._stop_reaction(reason)
-        self._end_move(-1, END_EXTERNAL_STOP, False, reason)
+        self._end_move(-1, End.EXTERNAL_STOP, False, reason)
         return True
 
     def reset_safety(self) -> bool:
@@ -278,20 +220,12 @@ class ContactControl:
         settings, applied bumplessly: the velocity commanded last stays, and the next cycles reach the new
         clamp within the acceleration and deceleration limits; the filter continues from its last output.
         Returns what changed, in words."""
-        old, self.settings = self.settings, s
-        self.intake.settings = s
+        self.settings = s
         self._tuning = tuple(s.tuning(i >= 3) for i in range(6))
-        self._diff = tuple(t.diff_max for t in self._tuning)
+        self._ends.diff = tuple(t.diff_max for t in self._tuning)
         self._reaction.retune(self._tuning)
         self._watch_floor_update()
-        changed = []
-        if (s.global_max_force, s.global_max_torque) != (old.global_max_force, old.global_max_torque):
-            self.preprocessor.set_limits(s.global_max_force, s.global_max_torque)
-            changed.append(f"global limits {s.global_max_force:g} N, {s.global_max_torque:g} Nm")
-        if s.lp_filter_cutoff_freq != old.lp_filter_cutoff_freq:
-            used = self.preprocessor.set_cutoff(s.lp_filter_cutoff_freq)
-            changed.append("no filter" if used is None else f"filter cutoff {used:.3g} Hz")
-        return changed
+        return self.intake.retune(s)
 
     # --- cycles ---
     def update(
@@ -322,8 +256,8 @@ class ContactControl:
             if self._reaction.active:
                 return self._react(t, w)
             self.intake.watch_drift(wrench, R_world_sensor, t)
-            return self._result(t, SAFETY_OK, "")
-        self._measure_travel(eef_pose, R_fixed_control)
+            return self._result(t, Safety.OK, "")
+        self._moved.measure(eef_pose, R_fixed_control)
         ended = self._check_ends(t, w, eef_pose, R_fixed_control)
         if ended is not None:
             return ended
@@ -331,9 +265,8 @@ class ContactControl:
         stopped = self._watch_oscillation(t)
         if stopped is not None:
             return stopped
-        if not all(self._armed):
-            self._arm(t)
-        return self._result(t, SAFETY_OK, "")
+        self._ends.arm(t)
+        return self._result(t, Safety.OK, "")
 
     def _accept(self, wrench: Sequence[float], t: float, stamp: float | None, T_control_sensor: Matrix | None,
                 R_world_sensor: Matrix | None) -> list[float] | CycleResult:
@@ -343,67 +276,42 @@ class ContactControl:
         if held is not None:
             return self._hold(t, *held)
         code, w = self.preprocessor.process(wrench, T_control_sensor, R_world_sensor)
-        if code == SAFETY_NAN:
-            return self._hold(t, SAFETY_NAN, "wrench contains NaN or inf: holding until valid data")
-        if code != SAFETY_OK:
+        if code == Safety.NAN:
+            return self._hold(t, Safety.NAN, "wrench contains NaN or inf: holding until valid data")
+        if code != Safety.OK:
             self._over_global += 1
             if self._over_global < self._limit_samples and not self._move.latched:
                 # A spike unless the next wrench is over too (force_limit_samples): a 15 N push on a 3.6 N
                 # current estimate crossed 25 N on single samples. The last command stands meanwhile.
-                return self._result(t, SAFETY_OK, "")
+                return self._result(t, Safety.OK, "")
             self._trip(w)
         else:
             self._over_global = 0
-        assert w is not None  # None only with SAFETY_NAN, returned above
+        assert w is not None  # None only with Safety.NAN, returned above
         if self._move.latched:
-            return self._hold(t, SAFETY_OVER_LIMIT, self._move.latch_message)
+            return self._hold(t, Safety.OVER_LIMIT, self._move.latch_message)
         self._wrench = w
         return w
-
-    def _measure_travel(self, eef_pose: Matrix | None, R_fixed_control: Matrix | None) -> None:
-        if eef_pose is None:
-            return
-        if not self._meter.started:
-            self._meter.start(eef_pose, R_fixed_control)
-        travel = self._travel
-        self._meter.measure(eef_pose, travel)
-        offset = self._travel_offset
-        if any(offset):
-            for i in range(6):
-                travel[i] -= offset[i]
 
     def _check_ends(self, t: float, w: list[float], eef_pose: Matrix | None,
                     R_fixed_control: Matrix | None) -> CycleResult | None:
         """The move's end conditions this cycle: a lost or left path, an axis's force limit (after
         `force_limit_samples` wrenches over it) or max travel, a force jump."""
-        laws, is_path, error = self._set.laws, self._set.is_path, self._path_error
+        laws, error = self._set.laws, self._path_error
         if self._set.path_axes:
             if eef_pose is None or not self._path.error(t, eef_pose, R_fixed_control, error,
                                                        self._path_velocity):
-                return self._end_and_hold(t, self._set.path_axes[0], END_PATH_LOST)
+                return self._end_and_hold(t, self._set.path_axes[0], End.PATH_LOST)
             for i in self._set.path_axes:
                 if 0.0 < laws[i].max_travel <= abs(error[i]):
-                    return self._end_and_hold(t, i, END_PATH_ERROR)
-        armed, over, travel = self._armed, self._over, self._travel
-        for i in self._set.active:
-            end = check_end(laws[i], w[i] if armed[i] else 0.0, 0.0 if is_path[i] else travel[i])
-            if end == END_FT_VIOLATION:
-                over[i] += 1
-                if over[i] < self._limit_samples:  # one spike over the limit is not a contact
-                    end = check_end(laws[i], 0.0, 0.0 if is_path[i] else travel[i])
-            elif over[i]:
-                over[i] = 0
-            if end:
-                return self._end_and_hold(t, i, end)
-        for i in self._set.diff_axes:
-            if self._windows[i].add(t, w[i]) > self._diff[i]:
-                return self._end_and_hold(t, i, END_DIFF_VIOLATION)
-        return None
+                    return self._end_and_hold(t, i, End.PATH_ERROR)
+        axis, end = self._ends.check(t, self._set, w, self._moved.values)
+        return self._end_and_hold(t, axis, end) if end else None
 
     def _step_velocities(self, t: float, w: list[float]) -> None:
         """Each active axis's law, then its velocity shaped by the rate limits over the cycle's dt."""
         dt = self._cycle_dt(t)
-        c, v, tuning, travel = self._set, self._v, self._tuning, self._travel
+        c, v, tuning, travel = self._set, self._v, self._tuning, self._moved.values
         error, reference, fast = self._path_error, self._path_velocity, self.preprocessor.fast
         for i in c.active:
             if c.is_path[i]:
@@ -426,44 +334,31 @@ class ContactControl:
             return None
         for i, lower, what in self._watch.check(t, self._v, self._set.watched, self._set.laws):
             if lower is None:
-                self._end_move(i, END_OSCILLATION, False, what)
-                return self._hold(t, SAFETY_OK, "")
+                self._end_move(i, End.OSCILLATION, False, what)
+                return self._hold(t, Safety.OK, "")
             self._set = self._set.with_law(i, lower)
             self._watch_floor_update()
             self.notes.append(what)
         return None
 
-    def _arm(self, t: float) -> None:
-        """Force limits count from force_limit_arm_time after the axes started from rest."""
-        if self._from_rest is None:
-            self._from_rest = t
-        if t - self._from_rest >= self._arm_time:
-            self._armed = [True] * 6
-
     def check_stale(self, t: float) -> CycleResult | None:
-        """Timer check: None while wrenches are fresh, else a zero-output result (SAFETY_STALE).
+        """Timer check: None while wrenches are fresh, else a zero-output result (Safety.STALE).
 
         Ends the move with NO_FT_DATA once data has been missing for `no_data_end_timeout`.
         """
         last, timeout, move = self.intake.last_wrench_time, self.intake.wrench_timeout, self._move
         if last is not None and t - last <= timeout:
             return None
-        if move.active and not move.t0 and t > 0.0:
-            # Set under sim time before the clock ran (a law set before `rosbag play --clock`): the move's
-            # wait for data starts with the clock, or it would end the moment the bag's clock appears.
-            move.t0 = t
         if move.active:
-            since = last if last is not None else move.t0
-            if move.t0 is not None and (since is None or since < move.t0):
-                since = move.t0
-            if since is not None and t - since >= self._end_timeout:
-                self._end_move(-1, END_NO_FT_DATA, False, f"no wrench for {t - since:.3f} s")
+            missing = move.without_data(t, last)
+            if missing >= self._end_timeout:
+                self._end_move(-1, End.NO_FT_DATA, False, f"no wrench for {missing:.3f} s")
         elif self._reaction.active and last is not None and t - last >= self._end_timeout:
             self._stop_reaction(f"no wrench for {t - last:.3f} s")
         age = "no wrench received yet" if last is None else f"no wrench for {t - last:.3f} s"
         if move.latched:  # the latch outranks staleness: it needs a reset, data alone will not clear it
-            return self._hold(t, SAFETY_OVER_LIMIT, f"{move.latch_message}; {age}")
-        return self._hold(t, SAFETY_STALE, f"{age} (wrench_timeout {timeout} s)")
+            return self._hold(t, Safety.OVER_LIMIT, f"{move.latch_message}; {age}")
+        return self._hold(t, Safety.STALE, f"{age} (wrench_timeout {timeout} s)")
 
     def hold(self, t: float, safety: int, message: str, received: bool = True) -> CycleResult:
         """Zero output for a reason found outside (e.g. SAFETY_NO_TF); the move resumes on the next update.
@@ -481,7 +376,7 @@ class ContactControl:
         if not message and not move.active:
             note = self._reaction.note
             message = f"{move.message}; {note}" if note else move.message
-        result = CycleResult(t, list(self._v), self._wrench, list(self._travel), list(self._shown),
+        result = CycleResult(t, list(self._v), self._wrench, list(self._moved.values), list(self._shown),
                              list(move.end), move.active, safety, message, move.ended_axis, move.id,
                              self._reaction.reacting(), list(self._set.actions))
         self.last_result = result
@@ -490,9 +385,7 @@ class ContactControl:
     def _hold(self, t: float, safety: int, message: str) -> CycleResult:
         self._v = [0.0] * 6
         self._last_t = None  # restart the rate limits from rest
-        if self._arm_time > 0.0:  # stopped at once: the speed-up that follows is a new start
-            self._armed = [False] * 6
-            self._from_rest = t
+        self._ends.held(t)
         return self._result(t, safety, message)
 
     def _watch_floor_update(self) -> None:
@@ -501,34 +394,24 @@ class ContactControl:
             self._watch.set_floor(self._tuning, self._set.laws, self.intake.noise_floor)
 
     def _end_and_hold(self, t: float, axis: int, condition: int) -> CycleResult:
-        law, name = self._set.laws[axis], AXES[axis]
-        if condition == END_FT_VIOLATION:
-            why = f"|{self._wrench[axis]:.3g}| reached the limit {law.force_limit}"
-        elif condition == END_PATH_LOST:
-            age = self._path.age(t)
-            why = ("no ~path_reference received" if age == math.inf else
-                   f"no ~path_reference for {age:.2f} s (path_reference_timeout {self._path.timeout:g} s)")
-        elif condition == END_PATH_ERROR:
-            unit = "rad" if axis >= 3 else "m"
-            why = f"|{self._path_error[axis]:.4g}| {unit} from the path reached max_travel {law.max_travel:g}"
-        elif condition == END_MAX_TRAVEL:
-            why = f"travel |{self._travel[axis]:.4g}| reached the max path deviation {law.max_travel}"
-        else:
-            why = f"force changed by more than {self._diff[axis]} within the window"
+        path = self._path
+        why = end_reason(axis, condition, self._set.laws[axis], force=self._wrench[axis],
+                         travel=self._moved.values[axis], path_error=self._path_error[axis],
+                         path_age=path.age(t), path_timeout=path.timeout, diff=self._ends.diff[axis])
         kept = self._v
-        self._end_move(axis, condition, True, f"axis {name}: {END_NAMES[condition]}: {why}")
-        if condition == END_FT_VIOLATION and self._reaction.start(self._set.laws, self._wrench):
+        self._end_move(axis, condition, True, why)
+        if condition == End.FT_VIOLATION and self._reaction.start(self._set.laws, self._wrench):
             for i in self._reaction.follower_axes():
-                self._shown[i] = LAW_FOLLOWER  # gravity compensation: what the axis runs now
-        elif condition == END_MAX_TRAVEL and self._reaction.coast(kept, self.settings.end_stop_time):
+                self._shown[i] = Law.FOLLOWER  # gravity compensation: what the axis runs now
+        elif condition == End.MAX_TRAVEL and self._reaction.coast(kept, self.settings.end_stop_time):
             self._v = kept  # from this cycle's velocity to rest over end_stop_time (exceeded.py)
-            return self._result(t, SAFETY_OK, "")
-        return self._hold(t, SAFETY_OK, "")
+            return self._result(t, Safety.OK, "")
+        return self._hold(t, Safety.OK, "")
 
     def _react(self, t: float, w: list[float]) -> CycleResult:
         """A cycle of the exceeded actions after the move ended (`exceeded.ExceededReaction`)."""
         self._reaction.step(w, self._v, self._cycle_dt(t))
-        return self._result(t, SAFETY_OK, "")
+        return self._result(t, Safety.OK, "")
 
     def _stop_reaction(self, reason: str) -> bool:
         """Ends the exceeded actions (stop, missing data); returns whether one ran."""
@@ -555,4 +438,4 @@ class ContactControl:
         self._move.latch(f"wrench over the global limit (|F| {force:.1f} N of {p.max_force} N, |T| "
                          f"{torque:.1f} Nm of {p.max_torque} Nm): holding until reset")
         if self._move.active:
-            self._end_move(-1, END_FT_VIOLATION, False, self._move.latch_message)
+            self._end_move(-1, End.FT_VIOLATION, False, self._move.latch_message)

@@ -101,6 +101,19 @@ class WrenchIntake:
             return self._zero(wrench, R_world_sensor, t)
         return None
 
+    def retune(self, s: ContactControlSettings) -> list[str]:
+        """New checked settings (live tuning): the global limits and the filter's cutoff apply at once, the
+        filter continuing from its last output. Returns what changed, in words."""
+        old, self.settings = self.settings, s
+        changed = []
+        if (s.global_max_force, s.global_max_torque) != (old.global_max_force, old.global_max_torque):
+            self.preprocessor.set_limits(s.global_max_force, s.global_max_torque)
+            changed.append(f"global limits {s.global_max_force:g} N, {s.global_max_torque:g} Nm")
+        if s.lp_filter_cutoff_freq != old.lp_filter_cutoff_freq:
+            used = self.preprocessor.set_cutoff(s.lp_filter_cutoff_freq)
+            changed.append("no filter" if used is None else f"filter cutoff {used:.3g} Hz")
+        return changed
+
     def restart_timing(self) -> None:
         """After a clock jump: no wrench counts as received, the rate is measured again."""
         self.last_wrench_time = None

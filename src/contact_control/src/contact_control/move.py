@@ -70,6 +70,17 @@ class MoveState:
             return None
         return self._outcomes.get(move_id, False)
 
+    def without_data(self, t: float, last: float | None) -> float:
+        """How long [s] the running move has been without a wrench at `t` (`last`: the newest one's time)."""
+        if not self.t0 and t > 0.0:
+            # Set under sim time before the clock ran (a law set before `rosbag play --clock`): the move's
+            # wait for data starts with the clock, or it would end the moment the bag's clock appears.
+            self.t0 = t
+        since = last if last is not None else self.t0
+        if self.t0 is not None and (since is None or since < self.t0):
+            since = self.t0
+        return 0.0 if since is None else t - since
+
     def latch(self, message: str) -> None:
         self.latched = True
         self.latch_message = message

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 
 from contact_control.preprocess import Matrix, as_rows
 
-__all__ = ["TravelMeter", "rotation_vector"]
+__all__ = ["MoveTravel", "TravelMeter", "rotation_vector"]
 
 _IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
@@ -80,3 +80,39 @@ class TravelMeter:
             # Express in the start control axes: Rc^T v.
             out[i] = s[i] * (rc[0][i] * dx + rc[1][i] * dy + rc[2][i] * dz)
             out[i + 3] = s[i + 3] * (rc[0][i] * ax + rc[1][i] * ay + rc[2][i] * az)
+
+
+class MoveTravel:
+    """A move's travel per axis (`values`): from the pose at its start, or, for an axis whose law changed
+    during the move, from the pose at the change."""
+
+    def __init__(self, directions: Sequence[int] = (1, 1, 1)) -> None:
+        self._meter = TravelMeter(directions)
+        self.values = [0.0] * 6
+        self._offset = [0.0] * 6  # an axis's travel when its law changed
+
+    def restart(self, T_fixed_eef: Matrix | None, R_fixed_control: Matrix | None) -> None:
+        """A new move: from `T_fixed_eef`, or from the next `measure`'s pose when None."""
+        self._offset = [0.0] * 6
+        self.values = [0.0] * 6
+        self._meter.clear()
+        if T_fixed_eef is not None:
+            self._meter.start(T_fixed_eef, R_fixed_control)
+
+    def restart_axis(self, axis: int) -> None:
+        """The axis's travel counts from here."""
+        self._offset[axis] += self.values[axis]
+        self.values[axis] = 0.0
+
+    def measure(self, T_fixed_eef: Matrix | None, R_fixed_control: Matrix | None) -> None:
+        """Updates `values` from the pose (None: unchanged); the first pose of a move is its start."""
+        if T_fixed_eef is None:
+            return
+        if not self._meter.started:
+            self._meter.start(T_fixed_eef, R_fixed_control)
+        travel = self.values
+        self._meter.measure(T_fixed_eef, travel)
+        offset = self._offset
+        if any(offset):
+            for i in range(6):
+                travel[i] -= offset[i]
