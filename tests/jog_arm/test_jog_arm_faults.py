@@ -65,6 +65,19 @@ def test_a_dead_driver_stops_the_arm_and_a_fresh_state_resumes_it_without_a_jump
     assert np.abs(np.diff(cell.speeds[n - 1 :])).max() <= max_step  # resumed without a jump
 
 
+def test_a_hung_command_source_stops_the_arm_within_8_mm_after_the_timeout(robot: Robot) -> None:
+    """The robot packages' set-up (incoming_cmd_timeout 0.1 s) jogging at 5 cm/s: twists stop coming (the
+    source hung, its connection open); 5 mm run on within the timeout, then a ramp down within the
+    acceleration limits. tests/robot_packages/test_robot_faults.py runs the same on the simulated arms."""
+    cell = Cell(robot, incoming_cmd_timeout=0.1)
+    cell.run(1.0)
+    assert cell.speeds[-1] > 0.0
+    start = cell.tip()
+    cell.run(1.0, twist=None)
+    assert cell.speeds[-1] == 0.0 and StatusCode.STALE_COMMAND in cell.status[-100:]
+    assert np.linalg.norm(cell.tip() - start) < 0.008
+
+
 def test_a_dropped_command_stops_at_once_not_after_the_timeout(robot: Robot) -> None:
     cell = Cell(robot, incoming_cmd_timeout=1.0)
     cell.run(1.0)

@@ -77,8 +77,14 @@ def _stopped(joints: Collector) -> bool:
     return max(abs(v) for v in joints.last().velocity) < 2e-3
 
 
+# How far the arm runs on is judged in simulated time by tests/jog_arm/test_jog_arm_faults.py (killed: within
+# 5 mm; hung: within 8 mm after incoming_cmd_timeout). Here, through the processes and in wall time, the arm
+# must stop and stay stopped; SMOKE_BOUND allows a 0.3 s stall of a loaded machine at 5 cm/s on top.
+SMOKE_BOUND = 0.025
+
+
 @pytest.mark.parametrize("robot", ["ur5_custom", "panda_custom"])
-def test_the_arm_stops_within_5_mm_when_the_command_source_is_killed_or_hangs(ros_node, robot):
+def test_the_arm_stops_when_the_command_source_is_killed_or_hangs(ros_node, robot):
     with run_launch(robot, "sim.launch") as h:
         _stack(h)
         pose = Collector("/mujoco_driver/eef_pose", PoseStamped)
@@ -86,27 +92,21 @@ def test_the_arm_stops_within_5_mm_when_the_command_source_is_killed_or_hangs(ro
         try:
             pose.wait_for(1, 20)
             joints.wait_for(1, 20)
-            # Killed: jog_arm stops as its connection closes. Hung: after incoming_cmd_timeout (0.1 s: 5 mm).
-            cases = (("killed (Ctrl-C)", signal.SIGINT, 0.005), ("hung (SIGSTOP)", signal.SIGSTOP, 0.008))
-            for how, sig, bound in cases:
-                runs = []
-                for _attempt in range(3):  # a stall of the shared VM can spoil one run; the bound is per run
-                    with _readme_jog(robot) as proc:
-                        _wait_for_travel(pose, 0.02)
-                        t0, x0 = time.monotonic(), _tip(pose)[0]
-                        _wait_for_travel(pose, 0.005)
-                        speed = (x0 - _tip(pose)[0]) / (time.monotonic() - t0)
-                        os.killpg(proc.pid, sig)
-                        stopped_at = time.monotonic()
-                        wait_until(lambda: _stopped(joints), 10, "the arm to stop")
-                        wait_until(lambda: _stopped(joints), 1, "the arm to stay stopped")
-                        runs.append(np.linalg.norm(_tip(pose) - _tip_at(pose, stopped_at)))
-                    assert speed > 0.6 * SPEED
-                    if runs[-1] <= bound:
-                        break
+            for how, sig in (("killed (Ctrl-C)", signal.SIGINT), ("hung (SIGSTOP)", signal.SIGSTOP)):
+                with _readme_jog(robot) as proc:
+                    _wait_for_travel(pose, 0.02)
+                    t0, x0 = time.monotonic(), _tip(pose)[0]
+                    _wait_for_travel(pose, 0.005)
+                    speed = (x0 - _tip(pose)[0]) / (time.monotonic() - t0)
+                    os.killpg(proc.pid, sig)
+                    stopped_at = time.monotonic()
+                    wait_until(lambda: _stopped(joints), 10, "the arm to stop")
+                    wait_until(lambda: _stopped(joints), 1, "the arm to stay stopped")
+                    ran = float(np.linalg.norm(_tip(pose) - _tip_at(pose, stopped_at)))
                 print(f"\n{robot}: jogging at {speed * 1e3:.0f} mm/s, source {how}: stopped after "
-                      + ", ".join(f"{d * 1e3:.2f}" for d in runs) + " mm")
-                assert runs[-1] <= bound, f"{how}: ran on {runs[-1] * 1e3:.1f} mm after the source vanished"
+                      f"{ran * 1e3:.2f} mm")
+                assert speed > 0.6 * SPEED
+                assert ran <= SMOKE_BOUND, f"{how}: ran on {ran * 1e3:.1f} mm after the source vanished"
         finally:
             pose.close()
             joints.close()

@@ -29,7 +29,9 @@ def test_the_survey_finds_the_arms_and_tells_why_the_rest_are_not_arms():
     assert "tiago_description/robots/tiago.urdf" in others  # an arm inside a robot: BASE= (tiago_custom)
 
 
-@pytest.mark.alone  # after the rest (make test): beside them, even idle-scheduled, it slowed the sims
+# After the simulations, beside the other `compute` tests (make test): beside a simulation, even
+# idle-scheduled, it slowed it.
+@pytest.mark.compute
 @pytest.mark.timeout(1800)  # its own: nine minutes of one core
 def test_make_robot_and_make_check_robot_on_every_arm_of_the_library():
     """On two processes (both cores), under SCHED_IDLE (chrt --idle) should it run beside anything."""

@@ -39,11 +39,6 @@ def stack(request, ros_node):
             runner.close()
 
 
-# The shared 2-core VM can freeze every process for 0.1-0.3 s (CPU steal), which spoils a run's
-# timing; such a run is repeated, at most ATTEMPTS times. A broken law fails every attempt.
-ATTEMPTS = 3
-
-
 def _run(stack, name):
     from thesis_demos.analysis import judge
     from thesis_demos.geometry import robot_setup
@@ -53,11 +48,7 @@ def _run(stack, name):
     setup = robot_setup(robot)  # the arm's directions and distances (<robot>_custom/config/demos.yaml)
     assert name not in setup.preflight(runner.start_tip()), setup.preflight(runner.start_tip())
     scenario = by_name([name], setup.geometry)[0]
-    for _ in range(ATTEMPTS):
-        verdict = judge(scenario, runner.run(scenario, "ft_sensor"))
-        if verdict.passed:
-            break
-    return robot, verdict
+    return robot, judge(scenario, runner.run(scenario, "ft_sensor"))
 
 
 def test_follower_z_moves_at_f_over_b_and_only_along_z(stack):
