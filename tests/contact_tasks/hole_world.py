@@ -95,7 +95,7 @@ class TaskLoop:
         self.commands.append(command)
         if command.reference is not None:
             r = command.reference
-            self.ctrl.set_path_reference(r.position, r.quaternion, r.twist, self.t)
+            self.ctrl.set_path_reference(r.position, r.quaternion, r.twist, self.t, r.horizon, r.horizon_step)
         if command.laws is not None:
             if command.restart:
                 self.ctrl.stop("the next step")

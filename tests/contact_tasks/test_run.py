@@ -122,3 +122,21 @@ def test_the_search_streams_a_spiral_reference_around_the_touch_point_in_the_too
     assert np.ptp([r.position[2] for r in search]) == 0.0  # the plane of the tool's x/y: horizontal
     q = search[0].quaternion  # the tool's orientation at the step's start (pointing down)
     assert abs(q[0]) == pytest.approx(1.0) and math.isclose(q[3], 0.0, abs_tol=1e-9)
+
+
+def test_each_search_reference_carries_where_the_spiral_will_be_next():
+    """With a 0.1 s horizon every 20 ms: a reference's horizon is the references the search sends later."""
+    loop = TaskLoop(TaskRun(load_task_file(PEG_IN_HOLE), horizon=0.1, horizon_step=0.02),
+                    HoleWorld(hole=(0.015, 0.0)), START)
+    loop.go(60.0)
+    search = [c.reference for c in loop.commands if c.step == "search" and c.reference is not None]
+    assert len(search) > 100
+    first = search[10]
+    assert first.horizon_step == 0.02 and len(first.horizon) == 5
+    later = np.array([r.position for r in search])
+    for j, (position, quaternion) in enumerate(first.horizon, start=1):
+        # The loop observes every 5 cycles of 2 ms: a reference every 10 ms, 20 ms on is two later.
+        assert np.allclose(position, later[10 + 2 * j], atol=1e-9)
+        assert np.allclose(quaternion, search[10 + 2 * j].quaternion, atol=1e-9)
+    assert np.linalg.norm(np.subtract(first.horizon[-1][0], first.position)) > 1e-4  # it moves on
+

@@ -33,6 +33,7 @@ from compliant_control_msgs.msg import (
 )
 from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsRequest
 from contact_control.frames import matrix_quaternion, quaternion_matrix
+from geometry_msgs.msg import Point, Pose, Quaternion
 from std_srvs.srv import Trigger
 
 from contact_tasks.params import TaskServerSettings, load_settings
@@ -158,6 +159,9 @@ class TaskServer:
             p.x, p.y, p.z = ref.position
             q.x, q.y, q.z, q.w = ref.quaternion
             v.linear.x, v.linear.y, v.linear.z, v.angular.x, v.angular.y, v.angular.z = ref.twist
+            msg.horizon_step = ref.horizon_step
+            msg.horizon = [Pose(position=Point(*position), orientation=Quaternion(*quaternion))
+                           for position, quaternion in ref.horizon]
             self._ref_pub.publish(msg)
         if command.laws is not None:
             if command.restart:
@@ -222,7 +226,7 @@ class TaskServer:
             self._server.set_aborted(ExecuteTaskResult(outcome="refused", message=why), why)
             return
         self._laws_at = math.inf
-        run = TaskRun(task)
+        run = TaskRun(task, self.s.path_horizon, self.s.path_horizon_step)
         obs = self._observe(tool)
         command = self._apply(run, run.start(obs), obs)
         rate, every = rospy.Rate(self.s.rate), max(1, round(self.s.rate / self.s.feedback_rate))

@@ -26,6 +26,12 @@ class TaskServerSettings:
     rate: float = param(100.0, unit="Hz", gt=0.0, le=200.0,
                         doc="steps checked and the path reference streamed this often (off contact_control's "
                         "cycle)")
+    path_horizon: float = param(
+        0.4, unit="s", ge=0.0, le=2.0,
+        doc="each path reference carries where the pattern goes this far ahead, which contact_control "
+        "follows when the stream is late (a stalled node) instead of stopping the tool. 0: none",
+    )
+    path_horizon_step: float = param(0.02, unit="s", gt=0.0, doc="the time between the horizon's poses")
     feedback_rate: float = param(10.0, unit="Hz", gt=0.0, le=100.0, doc="action feedback rate")
     status_timeout: float = param(2.0, unit="s", gt=0.0, doc="a task is refused when contact_control's "
                                   "`~status` has not come for this long")

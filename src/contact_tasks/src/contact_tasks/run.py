@@ -50,13 +50,21 @@ class Observation:
     released: bool = False
 
 
+Position = tuple[float, float, float]
+Orientation = tuple[float, float, float, float]  # a quaternion (x, y, z, w)
+
+
 @dataclass(frozen=True)
 class Reference:
-    """The path law's reference in the fixed frame: position [m], quaternion (x, y, z, w), twist."""
+    """The path law's reference in the fixed frame: position [m], quaternion (x, y, z, w), twist, and its
+    horizon: (position, quaternion) `horizon_step`, 2 `horizon_step`, ... [s] on (contact_control follows it
+    when the stream is late)."""
 
     position: tuple[float, float, float]
     quaternion: tuple[float, float, float, float]
     twist: tuple[float, float, float, float, float, float]
+    horizon: tuple[tuple[Position, Orientation], ...] = ()
+    horizon_step: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -96,8 +104,9 @@ class Result:
 class TaskRun:
     """One run of a task; `start`, then `update` every cycle until the outcome is not RUNNING."""
 
-    def __init__(self, task: Task) -> None:
+    def __init__(self, task: Task, horizon: float = 0.0, horizon_step: float = 0.02) -> None:
         self.task = task
+        self._ahead = (round(horizon / horizon_step) if horizon > 0.0 else 0, horizon_step)
         self.result = Result()
         self.step_name = ""
         self.depth = math.nan  # past the touch point along the approach [m]
@@ -151,7 +160,7 @@ class TaskRun:
         for i, ex in enumerate(self._step.exits):
             if self._holds(i, ex, obs, step_t, point):
                 return self._take(ex, obs, obs.move_message if ex.when == "move_ended" else "")
-        return Command(self.step_name, reference=self._reference(point))
+        return Command(self.step_name, reference=self._reference(point, step_t))
 
     def cancel(self, obs: Observation) -> Command:
         """The task is cancelled: stop the move."""
@@ -173,7 +182,7 @@ class TaskRun:
         self._since.clear()
         self.search_radius = 0.0
         self.result.step_times.setdefault(name, 0.0)
-        reference = self._reference(evaluate(step.pattern, 0.0)) if _has_path(step) else None
+        reference = self._reference(evaluate(step.pattern, 0.0), 0.0) if _has_path(step) else None
         return Command(name, laws=laws_request(step.laws), restart=restart, reference=reference)
 
     def _take(self, ex: Exit, obs: Observation, why: str) -> Command:
@@ -246,21 +255,31 @@ class TaskRun:
 
     # the reference
 
-    def _reference(self, point: PatternPoint) -> Reference | None:
+    def _reference(self, point: PatternPoint, step_t: float) -> Reference | None:
+        """The reference at `point` (the pattern at `step_t` into the step) and its horizon."""
         if self._step is None or not _has_path(self._step):
             return None
+        frame = self._frame
+        linear = frame @ np.asarray(point.twist[:3])
+        angular = frame @ np.asarray(point.twist[3:])
+        count, step = self._ahead
+        pattern = self._step.pattern
+        horizon = tuple(self._pose(evaluate(pattern, step_t + j * step)) for j in range(1, count + 1))
+        return Reference(
+            *self._pose(point),
+            (float(linear[0]), float(linear[1]), float(linear[2]),
+             float(angular[0]), float(angular[1]), float(angular[2])),
+            horizon, step if horizon else 0.0,
+        )
+
+    def _pose(self, point: PatternPoint) -> tuple[Position, Orientation]:
+        """The fixed frame's position and quaternion of a pattern point."""
         frame, start = self._frame, self._start_pose
         position = start[:3, 3] + frame @ np.asarray(point.offset)
         turn = np.asarray(quaternion_matrix(*_rotvec_quaternion(frame @ np.asarray(point.rotation))))
         x, y, z, w = matrix_quaternion((turn @ start[:3, :3]).tolist())
-        linear = frame @ np.asarray(point.twist[:3])
-        angular = frame @ np.asarray(point.twist[3:])
-        return Reference(
-            (float(position[0]), float(position[1]), float(position[2])),
-            (float(x), float(y), float(z), float(w)),
-            (float(linear[0]), float(linear[1]), float(linear[2]),
-             float(angular[0]), float(angular[1]), float(angular[2])),
-        )
+        return (float(position[0]), float(position[1]), float(position[2])), (float(x), float(y), float(z),
+                                                                              float(w))
 
 
 def _has_path(step: Step) -> bool:
