@@ -38,7 +38,9 @@ def driver(ros_node):
               "lockstep_wait": WAIT, "command_timeout": 0.1, "lockstep_echo_topic": f"{NS}/echo"}
     with run_node("mujoco_driver", "mujoco_driver", args=[f"__ns:={NS}"], params=params,
                   name="mujoco_driver") as h:
-        h.wait_for_topic("/clock")
+        # Its own service and topic: /clock may have other publishers on the session's master.
+        h.wait_for_service(f"{NS}/mujoco_driver/reset")
+        h.wait_for_topic(f"{NS}/joint_states")
         yield h
 
 
@@ -54,7 +56,11 @@ class Arm:
         self.velocity_pub = rospy.Publisher(f"{NS}/joint_group_velocity_controller/command",
                                             Float64MultiArray, queue_size=1, tcp_nodelay=True)
         for pub in (self.velocity_pub, self.echo_pub):
-            wait_until(lambda pub=pub: pub.get_num_connections() > 0, 10, f"the driver on {pub.name}")
+            try:
+                wait_until(lambda pub=pub: pub.get_num_connections() > 0, 10, f"the driver on {pub.name}")
+            except AssertionError as err:  # say whether the driver still runs, and what it printed
+                alive = "running" if handle.proc.poll() is None else f"exited with {handle.proc.returncode}"
+                raise AssertionError(f"{err} (the driver: {alive})\n{handle.output()[-3000:]}") from None
         self.clock.wait_for(1)
         self.joints.wait_for(1)
 
@@ -85,7 +91,7 @@ class Arm:
 @pytest.fixture
 def arm(driver, ros_node):
     """The driver after ~reset (which forgets an echo an earlier test left armed), and its topics."""
-    ros_node.wait_for_service(f"{NS}/mujoco_driver/reset", 10)
+    driver.wait_for_service(f"{NS}/mujoco_driver/reset", 10)  # says whether it died, with its output
     assert ros_node.ServiceProxy(f"{NS}/mujoco_driver/reset", Trigger)().success
     a = Arm(ros_node, driver)
     yield a
