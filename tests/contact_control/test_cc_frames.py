@@ -12,6 +12,7 @@ from contact_control.frames import (
     quaternion_matrix,
     rotate_twist,
     rotation,
+    times_transpose,
     transform,
     transpose_times,
 )
@@ -46,6 +47,7 @@ def test_compose_inverse_and_rotations(a, b):
     assert np.array(compose(inverse(A), A)) == pytest.approx(np.array(IDENTITY))
     Ra, Rb = np.array(rotation(A)), np.array(rotation(B))
     assert np.array(transpose_times(rotation(A), rotation(B))) == pytest.approx(Ra.T @ Rb)
+    assert np.array(times_transpose(A, B)) == pytest.approx(Ra @ Rb.T)  # 4x4 rows: their rotation blocks
     v = [0.1, -0.2, 0.3, 0.4, 0.5, -0.6]
     assert rotate_twist(rotation(A), v) == pytest.approx(np.concatenate([Ra @ v[:3], Ra @ v[3:]]))
 

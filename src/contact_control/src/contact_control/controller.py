@@ -15,6 +15,7 @@ from contact_control.axes import End, Law, Safety
 from contact_control.cycle import CycleResult
 from contact_control.ends import EndChecks, end_reason
 from contact_control.exceeded import ExceededReaction
+from contact_control.global_limit import GlobalLimit
 from contact_control.intake import WrenchIntake
 from contact_control.law_set import LawSet
 from contact_control.laws import AxisLaw, guard_pressing, law_velocity, path_velocity, shape_velocity
@@ -62,8 +63,7 @@ class ContactControl:
         self._last_t: float | None = None
         self._gain_bound = GainBound(s.loop_gain_delay, s.command_latency, s.spring_output_scale,
                                      s.contact_stiffness)
-        self._limit_samples = int(s.force_limit_samples)
-        self._over_global = 0  # wrenches in a row over a global limit
+        self._global = GlobalLimit(int(s.force_limit_samples))
         self._watch = (OscillationGuard(int(s.oscillation_reversals), s.oscillation_window, self._tuning)
                        if s.oscillation_reversals > 0 else None)
         self._requested: list[AxisLaw] = []  # the laws as last requested (the watchdog may lower them)
@@ -108,32 +108,18 @@ class ContactControl:
     def bound_gains(self, laws: Sequence[AxisLaw]) -> tuple[list[AxisLaw], list[str]]:
         """The laws with their loop gains within what the sensor's measured rate (`lp_filter_delta_t` until
         measured) and the command latency keep stable, and a note per lowered gain (see `loop_gain`)."""
-        period = self.intake.rate.period or self.settings.lp_filter_delta_t
-        cutoff = self.preprocessor.cutoff if self.settings.lp_filter_enabled else None
-        return self._gain_bound.limit(laws, period, cutoff)
+        return self._gain_bound.limit(laws, *self.intake.loop_timing())
 
     # --- commands ---
-    def set_laws(
-        self,
-        laws: Sequence[AxisLaw],
-        eef_pose: Matrix | None = None,
-        t: float | None = None,
-        R_fixed_control: Matrix | None = None,
-    ) -> int:
-        """Starts a move with six laws (x, y, z, rx, ry, rz), replacing any running move at once.
+    def set_laws(self, laws: Sequence[AxisLaw], eef_pose: Matrix | None = None, t: float | None = None,
+                 R_fixed_control: Matrix | None = None) -> int:
+        """Starts a move with six validated laws (x, y, z, rx, ry, rz; `request.validate_request`), replacing
+        any running move at once, and returns its id. `eef_pose`: the 4x4 EEF pose in the fixed frame at the
+        start (None: the next `update`'s); `t`: now [s] (for the no-data end timeout); `R_fixed_control`: the
+        control frame's orientation at the start (None: the fixed frame's).
 
-        Args:
-            laws: validated laws (see `request.validate_request`).
-            eef_pose: 4x4 EEF pose in the fixed frame at the start; None: taken from the next `update`.
-            t: current time [s] (for the no-data end timeout).
-            R_fixed_control: control frame orientation at the start (3x3); None: the fixed frame's.
-
-        Returns:
-            The new move id.
-
-        Raises:
-            RequestError: the global safety is latched (reset first); nothing changes.
-            ValueError: not six AxisLaw; nothing changes.
+        Raises RequestError (the global safety is latched: reset first) or ValueError (not six AxisLaw);
+        either way nothing changes.
         """
         laws = list(laws)
         if len(laws) != 6 or not all(isinstance(law, AxisLaw) for law in laws):
@@ -228,27 +214,15 @@ class ContactControl:
         return self.intake.retune(s)
 
     # --- cycles ---
-    def update(
-        self,
-        wrench: Sequence[float],
-        t: float,
-        T_control_sensor: Matrix | None = None,
-        R_world_sensor: Matrix | None = None,
-        eef_pose: Matrix | None = None,
-        R_fixed_control: Matrix | None = None,
-        stamp: float | None = None,
-    ) -> CycleResult:
-        """One control cycle for a received wrench.
-
-        Args:
-            wrench: (fx, fy, fz, tx, ty, tz) [N, Nm] in the sensor frame.
-            t: receive time [s], same clock as every other call.
-            T_control_sensor: 4x4 sensor pose in the control frame; None: same frame.
-            R_world_sensor: 3x3 sensor orientation in the fixed frame (for tool gravity).
-            eef_pose: 4x4 EEF pose in the fixed frame (for travel); None: travel not updated.
-            R_fixed_control: control frame orientation at the move's start, used if the start is taken now.
-            stamp: the wrench's header time [s] or None; older than wrench_timeout counts as no data.
-        """
+    def update(self, wrench: Sequence[float], t: float, T_control_sensor: Matrix | None = None,
+               R_world_sensor: Matrix | None = None, eef_pose: Matrix | None = None,
+               R_fixed_control: Matrix | None = None, stamp: float | None = None) -> CycleResult:
+        """One control cycle for a received wrench (fx, fy, fz, tx, ty, tz) [N, Nm] in the sensor frame,
+        received at `t` [s] (every call's clock), stamped `stamp` [s] (None: not stamped; older than
+        wrench_timeout counts as no data). Poses: the sensor in the control frame (4x4; None: the same
+        frame), the sensor's orientation in the fixed frame (3x3, for tool gravity), the EEF in the fixed
+        frame (4x4, for travel; None: not updated) and the control frame's orientation at the move's start,
+        used if the start is taken now."""
         w = self._accept(wrench, t, stamp, T_control_sensor, R_world_sensor)
         if isinstance(w, CycleResult):
             return w
@@ -278,15 +252,10 @@ class ContactControl:
         code, w = self.preprocessor.process(wrench, T_control_sensor, R_world_sensor)
         if code == Safety.NAN:
             return self._hold(t, Safety.NAN, "wrench contains NaN or inf: holding until valid data")
+        if self._global.spike(code != Safety.OK, self._move.latched):
+            return self._result(t, Safety.OK, "")
         if code != Safety.OK:
-            self._over_global += 1
-            if self._over_global < self._limit_samples and not self._move.latched:
-                # A spike unless the next wrench is over too (force_limit_samples): a 15 N push on a 3.6 N
-                # current estimate crossed 25 N on single samples. The last command stands meanwhile.
-                return self._result(t, Safety.OK, "")
             self._trip(w)
-        else:
-            self._over_global = 0
         assert w is not None  # None only with Safety.NAN, returned above
         if self._move.latched:
             return self._hold(t, Safety.OVER_LIMIT, self._move.latch_message)
@@ -297,15 +266,10 @@ class ContactControl:
                     R_fixed_control: Matrix | None) -> CycleResult | None:
         """The move's end conditions this cycle: a lost or left path, an axis's force limit (after
         `force_limit_samples` wrenches over it) or max travel, a force jump."""
-        laws, error = self._set.laws, self._path_error
-        if self._set.path_axes:
-            if eef_pose is None or not self._path.error(t, eef_pose, R_fixed_control, error,
-                                                       self._path_velocity):
-                return self._end_and_hold(t, self._set.path_axes[0], End.PATH_LOST)
-            for i in self._set.path_axes:
-                if 0.0 < laws[i].max_travel <= abs(error[i]):
-                    return self._end_and_hold(t, i, End.PATH_ERROR)
-        axis, end = self._ends.check(t, self._set, w, self._moved.values)
+        axis, end = self._path.check(t, eef_pose, R_fixed_control, self._set, self._path_error,
+                                     self._path_velocity)
+        if not end:
+            axis, end = self._ends.check(t, self._set, w, self._moved.values)
         return self._end_and_hold(t, axis, end) if end else None
 
     def _step_velocities(self, t: float, w: list[float]) -> None:
@@ -362,10 +326,7 @@ class ContactControl:
 
     def hold(self, t: float, safety: int, message: str, received: bool = True) -> CycleResult:
         """Zero output for a reason found outside (e.g. SAFETY_NO_TF); the move resumes on the next update.
-
-        Args:
-            received: a wrench did arrive at `t` (so the stale check does not also fire).
-        """
+        `received`: a wrench did arrive at `t` (so the stale check does not also fire)."""
         if received:
             self.intake.last_wrench_time = t
         return self._hold(t, safety, message)
@@ -428,14 +389,11 @@ class ContactControl:
         self._v = [0.0] * 6
 
     def _trip(self, w: list[float] | None) -> None:
-        force = (w[0] ** 2 + w[1] ** 2 + w[2] ** 2) ** 0.5 if w else float("nan")
-        torque = (w[3] ** 2 + w[4] ** 2 + w[5] ** 2) ** 0.5 if w else float("nan")
-        p = self.preprocessor
         if w:
             self._wrench = w  # ~status and the events show the wrench that tripped
         self._reaction.clear()  # nothing moves after a safety trip, whatever the exceeded action said
         self._v = [0.0] * 6
-        self._move.latch(f"wrench over the global limit (|F| {force:.1f} N of {p.max_force} N, |T| "
-                         f"{torque:.1f} Nm of {p.max_torque} Nm): holding until reset")
+        p = self.preprocessor
+        self._move.latch(self._global.message(w, p.max_force, p.max_torque))
         if self._move.active:
             self._end_move(-1, End.FT_VIOLATION, False, self._move.latch_message)

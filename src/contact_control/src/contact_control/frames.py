@@ -17,6 +17,7 @@ __all__ = [
     "rotate_twist",
     "rotation",
     "rotation_angle",
+    "times_transpose",
     "transform",
     "transpose_times",
 ]
@@ -98,6 +99,11 @@ def inverse(t: Sequence[Sequence[float]]) -> Rows:
 def transpose_times(a: Sequence[Sequence[float]], b: Sequence[Sequence[float]]) -> Rows:
     """a^T b for 3x3 rotations (e.g. R_command_control = R_fixed_command^T R_fixed_control)."""
     return [[a[0][i] * b[0][j] + a[1][i] * b[1][j] + a[2][i] * b[2][j] for j in range(3)] for i in range(3)]
+
+
+def times_transpose(a: Sequence[Sequence[float]], b: Sequence[Sequence[float]]) -> Rows:
+    """a b^T for 3x3 rotations (or the rotation blocks of 4x4s): the turn from b to a, in their frame."""
+    return [[a[i][0] * b[j][0] + a[i][1] * b[j][1] + a[i][2] * b[j][2] for j in range(3)] for i in range(3)]
 
 
 def rotate_twist(r: Sequence[Sequence[float]], v: Sequence[float]) -> list[float]:

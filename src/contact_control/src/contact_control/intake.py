@@ -114,6 +114,12 @@ class WrenchIntake:
             changed.append("no filter" if used is None else f"filter cutoff {used:.3g} Hz")
         return changed
 
+    def loop_timing(self) -> tuple[float, float | None]:
+        """The sample period the loop gains are bounded for (`lp_filter_delta_t` until measured) and the
+        filter's cutoff [Hz] (None: no filter)."""
+        cutoff = self.preprocessor.cutoff if self.settings.lp_filter_enabled else None
+        return self.rate.period or self.settings.lp_filter_delta_t, cutoff
+
     def restart_timing(self) -> None:
         """After a clock jump: no wrench counts as received, the rate is measured again."""
         self.last_wrench_time = None

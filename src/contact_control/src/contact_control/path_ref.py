@@ -15,7 +15,9 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from contact_control.frames import quaternion_matrix
+from contact_control.axes import End
+from contact_control.frames import quaternion_matrix, times_transpose
+from contact_control.law_set import LawSet
 from contact_control.preprocess import Matrix, as_rows
 from contact_control.travel import rotation_vector
 
@@ -92,9 +94,7 @@ class PathReference:
         (p0, q0), (p1, q1) = poses[k], poses[k + 1]
         sign = 1.0 if sum(a * b for a, b in zip(q0, q1, strict=True)) >= 0.0 else -1.0
         mid = [(1.0 - s) * a + s * sign * b for a, b in zip(q0, q1, strict=True)]
-        r0, r1 = quaternion_matrix(*q0), quaternion_matrix(*q1)
-        turn = [[sum(r1[i][n] * r0[j][n] for n in range(3)) for j in range(3)] for i in range(3)]  # R1 R0^T
-        w = rotation_vector(turn)
+        w = rotation_vector(times_transpose(quaternion_matrix(*q1), quaternion_matrix(*q0)))
         step = self._step
         v = tuple((p1[i] - p0[i]) / step for i in range(3)) + tuple(x / step for x in w)
         return tuple(a + s * (b - a) for a, b in zip(p0, p1, strict=True)), quaternion_matrix(*mid), v
@@ -120,12 +120,24 @@ class PathReference:
             # v / k past the last point (a stalled replay ran a UR3 12 mm past the L's corner).
             v = self._v if age <= self.extrapolate else (0.0,) * 6
         e = [p[i] + v[i] * dt - m[i][3] for i in range(3)]
-        # R_ref R_eef^T: the rotation still to go, in the fixed frame.
-        rd = [[r[i][0] * m[j][0] + r[i][1] * m[j][1] + r[i][2] * m[j][2] for j in range(3)] for i in range(3)]
-        e.extend(rotation_vector(rd))
+        e.extend(rotation_vector(times_transpose(r, m)))  # R_ref R_eef^T: the rotation still to go
         rc = _IDENTITY if R_fixed_control is None else as_rows(R_fixed_control)
         for k in (0, 3):
             for i in range(3):  # Rc^T x: along the control axes
                 error[k + i] = rc[0][i] * e[k] + rc[1][i] * e[k + 1] + rc[2][i] * e[k + 2]
                 velocity[k + i] = rc[0][i] * v[k] + rc[1][i] * v[k + 1] + rc[2][i] * v[k + 2]
         return True
+
+    def check(self, t: float, T_fixed_eef: Matrix | None, R_fixed_control: Matrix | None, laws: LawSet,
+              error: list[float], velocity: list[float]) -> tuple[int, int]:
+        """The path axes' end this cycle, as (axis, End): PATH_LOST without a pose or a live reference,
+        PATH_ERROR for an axis `max_travel` or more off the path; (-1, 0) otherwise (e and v_ref written:
+        `error`)."""
+        if not laws.path_axes:
+            return -1, 0
+        if T_fixed_eef is None or not self.error(t, T_fixed_eef, R_fixed_control, error, velocity):
+            return laws.path_axes[0], End.PATH_LOST
+        for i in laws.path_axes:
+            if 0.0 < laws.laws[i].max_travel <= abs(error[i]):
+                return i, End.PATH_ERROR
+        return -1, 0

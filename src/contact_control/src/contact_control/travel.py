@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+from contact_control.frames import times_transpose
 from contact_control.preprocess import Matrix, as_rows
 
 __all__ = ["MoveTravel", "TravelMeter", "rotation_vector"]
@@ -70,11 +71,7 @@ class TravelMeter:
         m = as_rows(T_fixed_eef)
         p0, r0, rc = self._p0, self._r0, self._rc
         dx, dy, dz = m[0][3] - p0[0], m[1][3] - p0[1], m[2][3] - p0[2]
-        # Orientation change in the fixed frame: R R0^T.
-        rd = [
-            [m[i][0] * r0[j][0] + m[i][1] * r0[j][1] + m[i][2] * r0[j][2] for j in range(3)] for i in range(3)
-        ]
-        ax, ay, az = rotation_vector(rd)
+        ax, ay, az = rotation_vector(times_transpose(m, r0))  # orientation change in the fixed frame: R R0^T
         s = self._signs
         for i in range(3):
             # Express in the start control axes: Rc^T v.
