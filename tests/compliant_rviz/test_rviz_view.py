@@ -5,6 +5,7 @@ COMPLIANT_RVIZ_WRITE_SCREENSHOT=1 to refresh the README's figure (src/compliant_
 
 from __future__ import annotations
 
+import contextlib
 import os
 import pathlib
 import shutil
@@ -25,12 +26,23 @@ SRC = pathlib.Path(__file__).resolve().parents[2] / "src"
 FIGURE = SRC / "compliant_rviz" / "doc" / "view.png"
 
 
+def _counts(picture) -> tuple[int, int, float]:
+    """(red pixels: the tool (URDF red) and the obstacle marker; pixels of the 3-D view's grey background;
+    the picture's standard deviation)."""
+    from PIL import Image
+
+    image = np.asarray(Image.open(picture).convert("RGB")).astype(int)
+    r, g, b = image[..., 0], image[..., 1], image[..., 2]
+    red = int(np.sum((r > 150) & (g < 90) & (b < 90)))
+    grey = int(np.sum((abs(r - 48) < 6) & (abs(g - 48) < 6) & (abs(b - 48) < 6)))
+    return red, grey, float(image.std())
+
+
 def test_viewer_rviz_shows_the_robot_the_laws_the_velocity_and_the_push(ros_node, tmp_path):
     from cartesian_impedance_msgs.msg import ControlLaw
     from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
     from compliant_control_msgs.msg import ContactControlStatus
     from compliant_control_msgs.srv import PushEEF, PushEEFRequest
-    from PIL import Image
     from visualization_msgs.msg import MarkerArray
 
     rospy = ros_node
@@ -86,19 +98,24 @@ def test_viewer_rviz_shows_the_robot_the_laws_the_velocity_and_the_push(ros_node
                 push_arrow = named(markers.last(), "push")
                 assert push_arrow.points[1].x < push_arrow.points[0].x  # drawn pushing toward -X
                 picture = tmp_path / "rviz.png"
-                screenshot(display, str(picture))
+                seen: list[tuple[int, int, float]] = []
+
+                def drawn() -> bool:  # RViz draws its 3-D view some frames after its window is mapped
+                    screenshot(display, str(picture))
+                    seen.append(_counts(picture))
+                    red, grey, std = seen[-1]
+                    return std > 20 and grey > 50_000 and red > 500
+
+                with contextlib.suppress(AssertionError):  # the assertions below say what was missing
+                    wait_until(drawn, 30, "RViz's 3-D view drawn")
                 wait_until(lambda: named(markers.last(), "push") is None, 10, "no push arrow after the push")
                 h.stop()
         finally:
             markers.close()
 
-    image = np.asarray(Image.open(picture).convert("RGB")).astype(int)
-    r, g, b = image[..., 0], image[..., 1], image[..., 2]
-    red = int(np.sum((r > 150) & (g < 90) & (b < 90)))  # the tool (URDF red) and the obstacle marker
-    grey = int(np.sum((abs(r - 48) < 6) & (abs(g - 48) < 6) & (abs(b - 48) < 6)))  # the 3-D view's background
-    print(f"\nscreenshot {image.shape[1]}x{image.shape[0]}: {red} red pixels, {grey} background, "
-          f"std {image.std():.1f}")
-    assert image.std() > 20, "a blank screen"
+    red, grey, std = seen[-1]
+    print(f"\n{len(seen)} screenshot(s), the last: {red} red pixels, {grey} background, std {std:.1f}")
+    assert std > 20, "a blank screen"
     assert grey > 50_000, "no 3-D view (RViz's background) on the screen"
     assert red > 500, "neither the tool nor the obstacle is drawn"
     if os.environ.get("COMPLIANT_RVIZ_WRITE_SCREENSHOT"):
