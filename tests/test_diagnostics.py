@@ -109,8 +109,8 @@ def test_jog_arm_and_driver_levels():
     from jog_arm.status import StatusCode
     from mujoco_driver.health import driver_health
 
-    def cycle(status: StatusCode, message: str = "") -> JogCycle:
-        return JogCycle(1.0, True, (), (), (), status, message, 12.0, 0.5, False)
+    def cycle(status: StatusCode, message: str = "", cap: float = float("inf")) -> JogCycle:
+        return JogCycle(1.0, True, (), (), (), status, message, 12.0, 0.5, cap, False)
 
     assert jog_health("/j", None, None, 500.0, "").level == ERROR
     assert jog_health("/j", cycle(StatusCode.STALE_COMMAND), 500.0, 500.0, "").message == "idle (no command)"
@@ -118,6 +118,11 @@ def test_jog_arm_and_driver_levels():
     assert halt.level == ERROR and halt.message == "condition 40 > 30"
     assert jog_health("/j", cycle(StatusCode.JOINT_VELOCITY_SCALED, "scaled"), None, 500.0, "").level == WARN
     assert jog_health("/j", cycle(StatusCode.NO_WARNING), 500.0, 500.0, "ROS master lost").level == ERROR
+    capped = jog_health("/j", cycle(StatusCode.COLLABORATIVE_SPEED_CAP, "capped", 0.157), 500.0, 500.0, "",
+                        "face")
+    assert capped.level == OK and capped.message == "capped"  # a limit working, not a fault
+    assert ("speed cap [m/s]", "0.157") in capped.values
+    assert ("body region (ISO/TS 15066)", "face") in capped.values
     assert driver_health("/d", 1.0, 1.0, 0.0, {}, 3.0, "velocity").level == OK
     slow = driver_health("/d", 0.4, 1.0, 2.5, {}, 3.0, "velocity")
     assert slow.level == ERROR and "real-time factor at 0.4, expected 1" in slow.message

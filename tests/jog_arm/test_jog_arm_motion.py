@@ -145,8 +145,10 @@ def test_unitless_commands_are_scaled_and_bounded(robot: Robot) -> None:
 def test_fast_command_scaled_as_a_whole_keeps_direction(robot: Robot) -> None:
     # Small steps keep the path straight between cycles; generous acceleration limits isolate the
     # velocity scaling (at these speeds a straight line needs more joint acceleration than the datasheet
-    # allows, and honouring that bends the path a little, which is right but not what this test is about).
-    jog = make_jog(robot, pub_period=0.002, default_max_acceleration=1000.0, joint_limits={})
+    # allows, and honouring that bends the path a little, which is right but not what this test is about);
+    # no collaborative speed cap (2 m/s is above the hand's).
+    jog = make_jog(robot, pub_period=0.002, default_max_acceleration=1000.0, joint_limits={},
+                   collaborative_region="off")
     arm = PerfectArm(jog, robot.start)
     p0 = arm.eef()
     trace = arm.run(60, (0.0, 0.0, -2.0, 0.0, 0.0, 0.0))  # far beyond what the joints can do

@@ -142,6 +142,8 @@ def test_replayed_state_twist_in_trajectory_out_then_stale_stop_and_refusals(ros
                 np.array(PANDA.start) + np.array(point.velocities) * 0.01
             )  # publish period, not CPU time
             np.testing.assert_allclose(point.positions, expected, atol=1e-9)
+            moving = status.last()  # the collaborative speed cap (default: the hand), far above 0.05 m/s
+            assert moving.body_region == "hand" and 1.0 < moving.speed_cap < 2.0, moving
 
             # The sender stops: smooth stop, the zero command 5 times, then silence. The node's publisher
             # keeps only the newest message (queue_size 1, as a controller wants), so on a busy machine a

@@ -4,7 +4,8 @@
 ERROR: no joint state or a stale one, a halt at a singularity or a joint limit (the arm is held). WARN:
 slowing for a singularity or a joint limit, joint velocities scaled down, the contact guard acting, an
 invalid command.
-OK: following commands, idle (no command), paused for a named-pose move.
+OK: following commands (also at the collaborative speed cap: the values name the cap and the body region),
+idle (no command), paused for a named-pose move.
 """
 
 from __future__ import annotations
@@ -32,8 +33,9 @@ _WORDS = {StatusCode.NO_WARNING: "following commands", StatusCode.STALE_COMMAND:
 
 
 def jog_health(name: str, cycle: JogCycle | None, cycles_per_second: float | None, expected: float,
-               master: str) -> Report:
-    """The report from the last cycle (None: none yet), the cycles run per second since the last report."""
+               master: str, region: str = "off") -> Report:
+    """The report from the last cycle (None: none yet), the cycles run per second since the last report,
+    and the collaborative speed cap's body region."""
     report = Report(name)
     if master:
         report.check(ERROR, master)
@@ -45,6 +47,9 @@ def jog_health(name: str, cycle: JogCycle | None, cycles_per_second: float | Non
         report.value("status", status.name)
         report.value("condition number", cycle.condition)
         report.value("speed scale", cycle.scale)
+        cap = cycle.speed_cap
+        report.value("speed cap [m/s]", f"{cap:.3f}" if cap < float("inf") else "none")
+    report.value("body region (ISO/TS 15066)", region)
     report.value("cycles [Hz]", "not measured" if cycles_per_second is None else f"{cycles_per_second:.1f}")
     report.value("cycles expected [Hz]", f"{expected:.1f} (1 / pub_period)")
     return report

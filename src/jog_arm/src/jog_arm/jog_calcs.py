@@ -12,7 +12,8 @@ cycle to the next (the last output, whether the arm is moving, the twist filter)
 3. The command's twist (SI units after ``unitless`` scaling, :mod:`~jog_arm.command_state`) rotated from its
    frame (:mod:`~jog_arm.command_frames`) into the root frame.
 4. Singularity scale, only if the condition number grows along the commanded joint motion (predicted by
-   a finite difference), so a command that backs out is never slowed; it scales the twist.
+   a finite difference), so a command that backs out is never slowed; then the collaborative speed cap
+   (:mod:`~jog_arm.speed_cap`); both scale the twist.
 5. Low-pass filter of the twist in root axes (unit DC gain, reset to the twist of the current output when
    motion (re)starts); joint velocity from the damped pseudo-inverse, on redundant arms plus a null-space
    pull toward the posture. (Filtering joint velocities blends J⁺ of past configurations: the tip drifts
@@ -48,6 +49,7 @@ from jog_arm.kinematics import ArmModel, KinematicsError
 from jog_arm.limits import JointLimiter
 from jog_arm.measured_joints import MeasuredJoints
 from jog_arm.settings import JogSettings, SettingsError
+from jog_arm.speed_cap import SpeedCap
 from jog_arm.status import StatusCode, motion_status
 
 __all__ = ["CommandResult", "JogCalcs", "JogOutput", "Point"]
@@ -67,8 +69,10 @@ class JogOutput(NamedTuple):
         message: Human-readable detail of `status`.
         condition_number: Of the tip Jacobian at the reference configuration (last computed; NaN before
             the first).
-        speed_scale: Product of the singularity, joint-limit and velocity scales applied to the command
-            (0 when there is nothing to follow).
+        speed_scale: Product of the singularity, speed cap, joint-limit and velocity scales applied to the
+            command (0 when there is nothing to follow).
+        speed_cap: The collaborative speed cap in the commanded direction [m/s] (inf: off, or no
+            translation commanded).
     """
 
     publish: bool
@@ -78,14 +82,16 @@ class JogOutput(NamedTuple):
     message: str
     condition_number: float
     speed_scale: float
+    speed_cap: float
 
 
 def _jog_output(publish: bool, positions: tuple[float, ...], velocities: tuple[float, ...],
-                status: StatusCode, message: str, condition_number: float, speed_scale: float) -> JogOutput:
+                status: StatusCode, message: str, condition_number: float, speed_scale: float,
+                speed_cap: float = math.inf) -> JogOutput:
     """`JogOutput(...)` in one allocation instead of two (and faster): calling the class with more than four
     fields allocates the call's argument array as well."""
     return tuple.__new__(JogOutput, (publish, positions, velocities, status, message, condition_number,
-                                     speed_scale))
+                                     speed_scale, speed_cap))
 
 
 class JogCalcs:
@@ -155,6 +161,9 @@ class JogCalcs:
                 )
             posture = self.joints.model_order(settings.nullspace_posture)
         self.solver = DampedSolver(self.model, settings, posture)
+        #: The collaborative speed cap (ISO/TS 15066).
+        self.speed_cap = SpeedCap(self.model, settings.singularity_length_scale,
+                                  settings.collaborative_region, settings.collaborative_payload)
         self.command_frames = CommandFrames(self.model)
         self.command = CommandState(settings, self.command_frames)
 
@@ -179,6 +188,7 @@ class JogCalcs:
         self.command.retune(settings)
         self._filter.set_coeff(settings.low_pass_filter_coeff)
         self.solver.retune(settings)
+        self.speed_cap.configure(settings.collaborative_region, settings.collaborative_payload)
 
     # --- inputs ---------------------------------------------------------------------------------------
 
@@ -297,8 +307,9 @@ class JogCalcs:
         if not follow and not any(self._dq_out):
             return self._hold(q_ref, status, message)
         # 2.-5. Joint velocity for the twist (zero when there is nothing to follow).
+        s_cap = 1.0
         if follow:
-            dq, condition, s_sing = self._follow(q_ref)
+            dq, condition, s_sing, s_cap = self._follow(q_ref)
             dq = self.solver.straighten(q_ref, dq)
         else:
             dq, condition, s_sing = self._no_follow(q_ref)
@@ -309,10 +320,13 @@ class JogCalcs:
         q_cmd = self._q_cmd = self._integrate(q_ref, dq_new)
 
         self._condition = condition
+        cap = self.speed_cap.last if follow else None
         if follow:
             self._zero_sent = 0
-            status, message = motion_status(condition, s_sing, s_pos, s_vel)
-            speed_scale = s_sing * s_pos * s_vel
+            status, message = motion_status(condition, s_sing, s_pos, s_vel, s_cap)
+            if status == StatusCode.COLLABORATIVE_SPEED_CAP:
+                message = self._cap_message()
+            speed_scale = s_sing * s_cap * s_pos * s_vel
         else:
             speed_scale = 0.0
             if not any(dq_new):
@@ -322,7 +336,13 @@ class JogCalcs:
         if resynced:
             message += " (re-synced to the measured joint state: tracking error above max_tracking_error)"
         return _jog_output(True, joints.user_order(q_cmd), joints.user_order(dq_new), status, message,
-                           condition, speed_scale)
+                           condition, speed_scale, math.inf if cap is None else cap.speed)
+
+    def _cap_message(self) -> str:
+        cap, region = self.speed_cap.last, self.speed_cap.region
+        assert region is not None  # a cap below 1 needs a region
+        return (f"speed capped to {cap.speed:.3f} m/s toward the {region.name} (ISO/TS 15066: "
+                f"{region.transient_force:g} N; effective mass {cap.robot_mass:.2f} kg)")
 
     def _start_running(self, q_arr: FloatArray) -> None:
         if not self._running:
@@ -336,9 +356,9 @@ class JogCalcs:
         self._filter_live = False
         return [0.0] * self.nv, geometry.condition, 1.0
 
-    def _follow(self, q_ref: list[float]) -> tuple[list[float], float, float]:
-        """Stages 2-5: the filtered joint velocity for the twist, the condition number and the singularity
-        scale applied."""
+    def _follow(self, q_ref: list[float]) -> tuple[list[float], float, float, float]:
+        """Stages 2-5: the filtered joint velocity for the twist, the condition number, the singularity scale
+        and the speed cap's scale applied."""
         solver = self.solver
         # 2. Jacobian, condition number, factorised damped J·Jᵀ (computed ahead by prefetch() if it could).
         geometry = solver.geometry(q_ref)
@@ -349,6 +369,8 @@ class JogCalcs:
         # 4. Singularity: judged on the unfiltered joint velocity, so the first cycle that backs out is not
         # slowed.
         s_sing = solver.singularity_slowdown(geometry, x)
+        s_cap = self.speed_cap.scale(geometry.q, J, x, s_sing)
+        s = s_sing * s_cap
         # 5. Low-pass filter on the scaled twist (root axes), started from the twist of the current output so
         # there is no start-up jump. Filtering joint velocities instead blends J⁺ of past configurations,
         # which moves the tip sideways while the Jacobian changes (2 mm over 15 cm at 20 Hz, 7 joints).
@@ -356,8 +378,8 @@ class JogCalcs:
             self._filter.reset((J @ np.asarray(self._dq_out)).tolist())
             self._filter_live = True
         xf = self._x_filtered
-        xf[:] = self._filter.filter((x * s_sing).tolist() if s_sing != 1.0 else x.tolist())
-        return solver.solve(J, xf, q_arr, s_sing).tolist(), condition, s_sing
+        xf[:] = self._filter.filter((x * s).tolist() if s != 1.0 else x.tolist())
+        return solver.solve(J, xf, q_arr, s_sing).tolist(), condition, s_sing, s_cap
 
     def _integrate(self, q_ref: list[float], dq: list[float]) -> list[float]:
         """Stage 7: positions = reference + velocity x pub_period (a copy filled in place: 3 allocations
@@ -370,10 +392,11 @@ class JogCalcs:
 
     def prefetch(self) -> None:
         """Computes the next cycle's twist-independent part now (Jacobian, condition number, factorisation),
-        so the next :meth:`step`, if its reference configuration is still this one, only solves for the
-        twist: call it after publishing, off the path from twist to command."""
+        and the speed cap's inverse mass, so the next :meth:`step`, if its reference configuration is still
+        this one, only solves for the twist: call it after publishing, off the path from twist to command."""
         if self.joints.received and self._running:
-            self.solver.geometry(self._reference()[0])
+            geometry = self.solver.geometry(self._reference()[0])
+            self.speed_cap.prepare(geometry.q, geometry.J)
 
     def _reference(self) -> tuple[list[float], bool]:
         """(reference configuration of the next step, whether it is a re-sync to the measured state)."""

@@ -97,6 +97,7 @@ class JogArmRos:
             msg.header.stamp = rospy.Time.from_sec(cycle.t)
             msg.code, msg.code_name, msg.message = int(cycle.status), cycle.status.name, cycle.message
             msg.condition_number, msg.speed_scale = cycle.condition, cycle.scale
+            msg.speed_cap, msg.body_region = cycle.speed_cap, self._stage.settings.collaborative_region
             if self._under:  # fewer than six joints: which rotations the twist cannot have (README)
                 axes = self._stage.jog.uncontrolled_rotations()
                 msg.uncontrolled_rotations = [Vector3(*axis) for axis in axes]
@@ -220,7 +221,8 @@ class JogArmRos:
             if self._counted is not None:
                 self._rate = (cycles - self._counted[1]) / (now - self._counted[0])
             self._counted = (now, cycles)
-        return jog_health(self._health_name, cycle, self._rate, 1.0 / self._s.pub_period, master)
+        return jog_health(self._health_name, cycle, self._rate, 1.0 / self._s.pub_period, master,
+                          self._stage.settings.collaborative_region)
 
     def master_lost(self, reason: str) -> None:
         rospy.logerr("jog_arm_server: %s: stopping the arm until it returns", reason)

@@ -14,6 +14,8 @@ from compliant_common.errors import StackError
 from compliant_common.schema import SchemaError, param, schema_of
 from compliant_common.typedefs import ParamMap
 
+from jog_arm.body_regions import OFF, REGIONS
+
 __all__ = [
     "COMMAND_IN_TYPES",
     "COMMAND_OUT_TYPES",
@@ -219,6 +221,16 @@ class JogSettings:
     contact_guard_wrench_topic: str = param(
         "contact_control_node/contact_wrench", doc="two-node layout: where the contact force comes from"
     )
+    # the collaborative speed cap (ISO/TS 15066; speed_cap.py)
+    collaborative_region: str = param(
+        "hand", choices=(OFF, *REGIONS),
+        doc="body region of ISO/TS 15066 the tip's speed is capped for, in the direction it moves (README: "
+        "[collaborative speed cap](#collaborative-speed-cap)); `off`: no cap",
+    )
+    collaborative_payload: float = param(
+        0.0, unit="kg", ge=0.0,
+        doc="mass at the tip that the URDF lacks (a grasped part), added to the arm's effective mass",
+    )
 
     @classmethod
     def from_params(cls, params: ParamMap, prefix: str = "jog_arm_server/") -> JogSettings:
@@ -327,7 +339,7 @@ TUNABLE = (
     "scale/linear", "scale/rotational", "low_pass_filter_coeff", "incoming_cmd_timeout",
     "singularity_threshold", "hard_stop_singularity_threshold", "pinv_damping", "pinv_damping_threshold",
     "contact_guard_max_force", "contact_guard_slow_force", "contact_guard_slow_speed",
-    "contact_guard_timeout", "contact_guard_relief_speed",
+    "contact_guard_timeout", "contact_guard_relief_speed", "collaborative_region", "collaborative_payload",
 )
 
 

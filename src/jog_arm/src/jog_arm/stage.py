@@ -35,7 +35,8 @@ ContactSource = Callable[[], "tuple[Sequence[float], str, float] | None"]
 NOTE_SHOWN_FOR = 1.0  # [s] a clock jump stays in the status at least this long
 MISSED_WARNING_EVERY = 10.0  # [s] between warnings about missed cycles
 # While the contact guard cuts an outside twist, the status says so instead of these (why the arm stops).
-_GUARD_OUTRANKS = (StatusCode.NO_WARNING, StatusCode.JOINT_VELOCITY_SCALED, StatusCode.STALE_COMMAND)
+_GUARD_OUTRANKS = (StatusCode.NO_WARNING, StatusCode.JOINT_VELOCITY_SCALED, StatusCode.STALE_COMMAND,
+                   StatusCode.COLLABORATIVE_SPEED_CAP)
 
 
 class JogCycle(NamedTuple):
@@ -47,7 +48,7 @@ class JogCycle(NamedTuple):
         positions: The command's joint positions [rad] (a trajectory's first point, `pub_period` ahead).
         velocities: The command's joint velocities [rad/s] (also all of a velocity interface's command).
         ahead: A trajectory's further points (simu mode: `simu_points` - 1 extrapolated ones), else ().
-        status, message, condition, scale: For the status message.
+        status, message, condition, scale, speed_cap: For the status message.
         status_changed: The status code differs from the previous cycle's (worth a log line).
     """
 
@@ -60,15 +61,16 @@ class JogCycle(NamedTuple):
     message: str
     condition: float
     scale: float
+    speed_cap: float
     status_changed: bool
 
 
 def _jog_cycle(t: float, publish: bool, positions: tuple[float, ...], velocities: tuple[float, ...],
                ahead: tuple[Point, ...], status: StatusCode, message: str, condition: float, scale: float,
-               status_changed: bool) -> JogCycle:
+               speed_cap: float, status_changed: bool) -> JogCycle:
     """`JogCycle(...)` in one allocation instead of two (see `jog_calcs._jog_output`)."""
     return tuple.__new__(JogCycle, (t, publish, positions, velocities, ahead, status, message, condition,
-                                    scale, status_changed))
+                                    scale, speed_cap, status_changed))
 
 
 class JogStage:
@@ -259,7 +261,8 @@ class JogStage:
         changed = status != self._last_status
         self._last_status = status
         cycle = self._last_cycle = _jog_cycle(t, out.publish, out.positions, out.velocities, ahead, status,
-                                              message, out.condition_number, out.speed_scale, changed)
+                                              message, out.condition_number, out.speed_scale, out.speed_cap,
+                                              changed)
         return cycle
 
     @property
@@ -317,6 +320,7 @@ def log_level(status: StatusCode) -> str:
     """How loudly a change to `status` is logged: "debug", "info" or "warn"."""
     if status in (StatusCode.NO_WARNING, StatusCode.STALE_COMMAND, StatusCode.JOINT_VELOCITY_SCALED):
         return "debug"
-    if status in (StatusCode.PAUSED, StatusCode.NO_JOINT_STATE, StatusCode.CONTACT_GUARD):
+    if status in (StatusCode.PAUSED, StatusCode.NO_JOINT_STATE, StatusCode.CONTACT_GUARD,
+                  StatusCode.COLLABORATIVE_SPEED_CAP):
         return "info"
     return "warn"

@@ -23,11 +23,14 @@ class StatusCode(IntEnum):
     NO_JOINT_STATE = 9
     STALE_JOINT_STATE = 10
     CONTACT_GUARD = 11
+    COLLABORATIVE_SPEED_CAP = 12
 
 
-def motion_status(condition: float, s_sing: float, s_pos: float, s_vel: float) -> tuple[StatusCode, str]:
+def motion_status(condition: float, s_sing: float, s_pos: float, s_vel: float,
+                  s_cap: float = 1.0) -> tuple[StatusCode, str]:
     """Status of a cycle that follows a command, from the scales applied to it (a halt before a slow-down,
-    the singularity before the joint limits)."""
+    the singularity before the joint limits, the collaborative speed cap before the joint velocities; the
+    caller words the cap's message)."""
     if s_sing == 0.0:
         return StatusCode.HALT_FOR_SINGULARITY, f"halted: condition number {condition:.1f} at hard stop"
     if s_pos == 0.0:
@@ -39,6 +42,8 @@ def motion_status(condition: float, s_sing: float, s_pos: float, s_vel: float) -
         )
     if s_pos < 1.0:
         return StatusCode.DECELERATE_FOR_JOINT_LIMIT, "slowing down near a joint position limit"
+    if s_cap < 1.0:
+        return StatusCode.COLLABORATIVE_SPEED_CAP, "speed capped (ISO/TS 15066)"
     if s_vel < 1.0:
         return StatusCode.JOINT_VELOCITY_SCALED, "command scaled to the joint velocity limits"
     return StatusCode.NO_WARNING, "moving"
