@@ -231,3 +231,37 @@ def test_move_to_joints_goes_to_given_positions_and_refuses_missing_or_out_of_li
     far = move(joint_names=names, positions=[100.0, *goal[1:]], speed_scale=1.0, label="")
     assert not far.success and "outside the joint's limits" in far.message
     assert _proxy()(name="start", speed_scale=1.0).success
+
+
+def test_a_move_toward_the_face_region_is_slowed_to_the_collaborative_speed_cap(stack):
+    """The region set live on jog_arm (dynamic_reconfigure, as `dynparam set` does) caps the next named-pose
+    move too: the tool's speed stays within the cap the answer names."""
+    import re
+
+    import rospy
+    from dynamic_reconfigure.client import Client
+    from geometry_msgs.msg import PoseStamped
+
+    client = Client("/jog_arm_server", timeout=20)
+    poses = Collector("/mujoco_driver/eef_pose", PoseStamped, queue_size=5000)
+    try:
+        client.update_configuration({"collaborative_region": "face"})
+        assert rospy.get_param("/jog_arm_server/collaborative_region") == "face"
+        poses.wait_for(1)
+        answer = _proxy()(name="home", speed_scale=1.0)
+        assert answer.success, answer.message
+        found = re.search(r"speed cap \(([0-9.]+) m/s at the tip toward the face", answer.message)
+        assert found, answer.message
+        cap = float(found.group(1))
+        msgs = [m for _, m in poses.timed()]
+        tips = np.array([[m.pose.position.x, m.pose.position.y, m.pose.position.z] for m in msgs])
+        stamps = np.array([m.header.stamp.to_sec() for m in msgs])  # simulated time
+        step = np.linalg.norm(np.diff(tips, axis=0), axis=1) / np.maximum(np.diff(stamps), 1e-6)
+        print(f"\ncap {cap} m/s, tool speed peak {step.max():.3f} m/s; {answer.message}")
+        # eef_pose is the tool tip, jog_arm's ee_frame_name too; the servos' tracking adds a few percent.
+        assert 0.5 * cap < step.max() <= 1.1 * cap
+    finally:
+        client.update_configuration({"collaborative_region": "hand"})
+        poses.close()
+        back = _proxy()(name="start", speed_scale=1.0)
+        assert back.success, back.message

@@ -21,7 +21,7 @@ from compliant_common.typedefs import FloatArray
 from jog_arm.body_regions import OFF, BodyRegion, max_speed, region_named
 from jog_arm.kinematics import ArmModel
 
-__all__ = ["CapReading", "SpeedCap"]
+__all__ = ["CapReading", "SpeedCap", "path_speed_limit"]
 
 
 class CapReading(NamedTuple):
@@ -117,3 +117,25 @@ class SpeedCap:
         cap = max_speed(region, mass)
         self.last = CapReading(cap, mass)
         return min(1.0, cap / speed)
+
+
+def path_speed_limit(cap: SpeedCap, model: ArmModel, start: FloatArray, delta: FloatArray,
+                     samples: int = 100) -> CapReading:
+    """The cap on a joint-space line q(s) = `start` + s `delta` (model order), s in [0, 1]: the largest
+    ds/dt that keeps the tip within the cap at every sample (`speed`, inf: off or the tip does not
+    translate), and the effective mass where it binds. `cap` is made with length scale 1 (plain Jacobian)."""
+    region, best = cap.region, _NONE
+    if region is None:
+        return best
+    for s in np.linspace(0.0, 1.0, samples):
+        q = start + s * delta
+        J = model.jacobian(q)
+        v = J[:3] @ delta  # the tip's velocity per unit ds/dt
+        speed = math.sqrt(float(v @ v))
+        if speed < 1e-9:
+            continue
+        mass = cap.robot_mass(q.tolist(), J, v)
+        allowed = max_speed(region, mass) / speed
+        if allowed < best.speed:
+            best = CapReading(allowed, mass)
+    return best

@@ -28,11 +28,14 @@ from compliant_control_msgs.srv import (
     MoveToNamedPoseResponse,
 )
 from controller_manager_msgs.srv import ListControllers, SwitchController, SwitchControllerRequest
+from jog_arm.body_regions import max_speed, region_named
+from jog_arm.kinematics import KinematicsError
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from named_poses.params import FILE_KEYS, load_settings
+from named_poses.path_cap import PathCap
 from named_poses.poses import NamedPoses, PoseError, urdf_joints
 from named_poses.profile import MotionProfileError, plan_move
 from named_poses.switching import Controller, Switch, SwitchError, controller_of, plan_switch
@@ -81,6 +84,12 @@ class NamedPoseServer:
         self._controller = controller_of(settings.trajectory_topic)
         self._manager = rospy.resolve_name(settings.controller_manager) if settings.controller_manager else ""
         self._jog = rospy.resolve_name(settings.jog_arm) if settings.jog_arm else ""
+        # The collaborative speed cap: jog_arm's tip frame (else the last pose joint's), region and payload.
+        tip = rospy.get_param(f"{self._jog}/ee_frame_name", "") if self._jog else ""
+        try:
+            self._path_cap = PathCap(urdf, list(self.poses.joints), tip or self.poses.joints[-1])
+        except KinematicsError as exc:
+            raise PoseError(f"the collaborative speed cap's tip ({self._jog}/ee_frame_name): {exc}") from None
         rospy.Subscriber(settings.joint_states_topic, JointState, self._on_joints,
                          queue_size=1, tcp_nodelay=True)
         rospy.Subscriber(settings.contact_control_status,
@@ -226,12 +235,15 @@ class NamedPoseServer:
                 f"no joint state for {list(self.poses.joints)} within {self.state_wait:g} s "
                 f"(is the driver publishing {self._states_topic}?)"
             )
+        region = rospy.get_param(f"{self._jog}/collaborative_region", "hand") if self._jog else "hand"
+        payload = rospy.get_param(f"{self._jog}/collaborative_payload", 0.0) if self._jog else 0.0
         try:
             goal = make_goal(current)
-            move = plan_move(
-                current, goal, self.poses.max_velocity * scale, self.poses.max_acceleration * scale
-            )
-        except (PoseError, MotionProfileError) as exc:
+            cap = self._path_cap.limit(region, payload, current, goal)
+            limits = (self.poses.max_velocity * scale, self.poses.max_acceleration * scale)
+            move = plan_move(current, goal, *limits, max_path_speed=cap.speed)
+            capped = move.duration > plan_move(current, goal, *limits).duration + 1e-9
+        except (PoseError, MotionProfileError, ValueError) as exc:
             return self._refuse(str(exc))
         msg = JointTrajectory()
         msg.joint_names = list(self.poses.joints)
@@ -260,6 +272,10 @@ class NamedPoseServer:
             note = f"; switched {list(switch.start)} on for the move (stopping {list(switch.stop)})"
             answer.message += note + (", then back" if back else f"; switching back failed: {back.reason}")
         answer.message += resumed
+        if capped:
+            tip_speed = max_speed(region_named(region), cap.robot_mass)
+            answer.message += (f"; slowed to the collaborative speed cap ({tip_speed:.2f} m/s at the tip "
+                               f"toward the {region}, ISO/TS 15066)")
         return answer
 
     # --- jog_arm pause (README, Jogging during a move) ---

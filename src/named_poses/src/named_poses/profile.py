@@ -54,6 +54,7 @@ def plan_move(
     max_velocity: Sequence[float] | np.ndarray,
     max_acceleration: Sequence[float] | np.ndarray,
     sample_period: float = 0.02,
+    max_path_speed: float = math.inf,
 ) -> JointMove:
     """Plan the synchronised rest-to-rest move from `start` to `goal`.
 
@@ -63,6 +64,8 @@ def plan_move(
         max_velocity: Per-joint velocity limits [rad/s], > 0.
         max_acceleration: Per-joint acceleration limits [rad/s^2], > 0.
         sample_period: Spacing of the samples [s] (the driver interpolates between them).
+        max_path_speed: The largest ds/dt of the path s in [0, 1] (the collaborative speed cap's,
+            `jog_arm.speed_cap.path_speed_limit`) [1/s], > 0.
 
     Returns:
         The sampled move; a single sample at t = 0 if already there.
@@ -83,6 +86,8 @@ def plan_move(
     if np.any(vmax <= 0) or np.any(amax <= 0):
         raise MotionProfileError(
             f"limits must be positive: velocity {vmax.tolist()}, acceleration {amax.tolist()}")
+    if not max_path_speed > 0:
+        raise MotionProfileError(f"max_path_speed must be positive, got {max_path_speed}")
     if not sample_period > 0:
         raise MotionProfileError(f"sample_period must be positive, got {sample_period}")
     delta = q1 - q0
@@ -91,7 +96,7 @@ def plan_move(
         zero = np.zeros((1, len(q0)))
         return JointMove(np.zeros(1), q1[None, :].copy(), zero, 0.0)
     # Largest ds/dt and d2s/dt2 that keep every moving joint within its limits.
-    speed = float(np.min(vmax[moving] / np.abs(delta[moving])))
+    speed = min(float(np.min(vmax[moving] / np.abs(delta[moving]))), max_path_speed)
     accel = float(np.min(amax[moving] / np.abs(delta[moving])))
     t_acc, t_cruise, v_peak = _scalar_profile(speed, accel)
     duration = 2.0 * t_acc + t_cruise
