@@ -15,6 +15,7 @@ from compliant_rviz.markers import (
     Box,
     Trail,
     axis_text,
+    cap_text,
     obstacle_box,
     velocity_arrow,
 )
@@ -37,6 +38,12 @@ def test_the_text_names_each_axis_law_with_its_force_and_velocity_and_says_when_
     assert axis_text([AxisLine("x", "none", 0.0, 0.0)]) == "no law"
     stale = axis_text([], "stale wrench", "no wrench for 0.2 s")
     assert stale.endswith("SAFETY: stale wrench (no wrench for 0.2 s)")
+
+
+def test_the_speed_cap_line_says_the_cap_and_region_and_when_it_slows_the_motion():
+    assert cap_text(1.3682, "hand", False) == "speed cap 1.37 m/s (hand, ISO/TS 15066)"
+    assert cap_text(0.157, "face", True) == "CAPPED at 0.16 m/s (face, ISO/TS 15066)"
+    assert cap_text(math.inf, "hand", False) == "" and cap_text(0.5, "off", False) == ""
 
 
 def test_the_velocity_arrow_starts_at_the_tool_and_is_two_seconds_of_motion_long():

@@ -95,6 +95,9 @@ def test_viewer_rviz_shows_the_robot_the_laws_the_velocity_and_the_push(ros_node
                 wait_until(following, 10, "the velocity and push arrows along -X, three times running")
                 text = named(markers.last(), "laws").text
                 assert text.startswith("x: follower") and "mm/s" in text, text
+                wait_until(lambda: "speed cap" in named(markers.last(), "laws").text, 5,
+                           "jog_arm's speed cap in the text while the tool moves")
+                assert "(hand, ISO/TS 15066)" in named(markers.last(), "laws").text
                 push_arrow = named(markers.last(), "push")
                 assert push_arrow.points[1].x < push_arrow.points[0].x  # drawn pushing toward -X
                 picture = tmp_path / "rviz.png"

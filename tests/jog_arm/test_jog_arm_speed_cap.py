@@ -15,6 +15,8 @@ from jog_arm.speed_cap import SpeedCap
 from jog_arm.status import StatusCode
 from jog_arm_testing import PANDA, UR5, PerfectArm, Robot, make_jog
 
+pytestmark = pytest.mark.cobot_safety
+
 # Worked by hand: hand (Annex A: 140 N quasi-static, F_T = 280 N, k = 75 N/mm, m_H = 0.6 kg), m_R = 10 kg:
 # mu = 1 / (1/0.6 + 1/10) = 0.5660 kg, v = 280 / sqrt(0.5660 * 75000) = 1.359 m/s. Face (65 N, no transient
 # contact: F_T = 65 N, 75 N/mm, 4.4 kg), m_R = 10 kg: mu = 3.0556 kg, v = 65 / sqrt(3.0556 * 75000) = 0.1358.

@@ -233,6 +233,7 @@ def test_move_to_joints_goes_to_given_positions_and_refuses_missing_or_out_of_li
     assert _proxy()(name="start", speed_scale=1.0).success
 
 
+@pytest.mark.cobot_safety
 def test_a_move_toward_the_face_region_is_slowed_to_the_collaborative_speed_cap(stack):
     """The region set live on jog_arm (dynamic_reconfigure, as `dynparam set` does) caps the next named-pose
     move too: the tool's speed stays within the cap the answer names."""

@@ -15,6 +15,8 @@ from jog_arm.speed_cap import SpeedCap
 from named_poses.path_cap import PathCap
 from named_poses.profile import plan_move
 
+pytestmark = pytest.mark.cobot_safety
+
 URDF = (pathlib.Path(sys.prefix) / "lib/python3.11/site-packages/cmeel.prefix/share/example-robot-data/robots"
         / "ur_description/urdf/ur5_robot.urdf").read_text()
 JOINTS = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint",

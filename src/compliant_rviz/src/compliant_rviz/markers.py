@@ -11,7 +11,9 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-__all__ = ["ARROW_SECONDS", "AxisLine", "Box", "Trail", "axis_text", "obstacle_box", "velocity_arrow"]
+__all__ = [
+    "ARROW_SECONDS", "AxisLine", "Box", "Trail", "axis_text", "cap_text", "obstacle_box", "velocity_arrow",
+]
 
 ARROW_SECONDS = 2.0  # the velocity arrow is this many seconds of motion long (0.1 m/s: 0.2 m)
 MIN_ARROW = 1e-4  # [m/s] slower than this draws no arrow
@@ -49,6 +51,14 @@ def axis_text(lines: Sequence[AxisLine], safety: str = "ok", message: str = "") 
     if safety != "ok":
         rows.append(f"SAFETY: {safety}" + (f" ({message})" if message else ""))
     return "\n".join(rows)
+
+
+def cap_text(speed_cap: float, region: str, capped: bool) -> str:
+    """jog_arm's collaborative speed cap (its status' `speed_cap`, `body_region`, and whether it slows the
+    motion now): '' while nothing translates or the cap is off."""
+    if not math.isfinite(speed_cap) or region in ("", "off"):
+        return ""
+    return f"{'CAPPED at' if capped else 'speed cap'} {speed_cap:.2f} m/s ({region}, ISO/TS 15066)"
 
 
 def velocity_arrow(tip: Sequence[float], linear: Sequence[float]) -> tuple[np.ndarray, np.ndarray] | None:

@@ -13,12 +13,12 @@ import rospy
 import tf2_ros
 import yaml
 from compliant_common.ros_time import timer
-from compliant_control_msgs.msg import ContactControlStatus, PathReference
+from compliant_control_msgs.msg import ContactControlStatus, JogStatus, PathReference
 from geometry_msgs.msg import Point, WrenchStamped
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
-from compliant_rviz.markers import AxisLine, Box, Trail, axis_text, obstacle_box, velocity_arrow
+from compliant_rviz.markers import AxisLine, Box, Trail, axis_text, cap_text, obstacle_box, velocity_arrow
 
 __all__ = ["StackMarkers", "main"]
 
@@ -37,10 +37,12 @@ class StackMarkers:
 
     def __init__(self) -> None:
         cc = rospy.get_param("~contact_control", "/contact_control_node").rstrip("/")
+        jog = rospy.get_param("~jog_arm", "/jog_arm_server").rstrip("/")
         self.base = rospy.get_param("~base_frame", rospy.get_param(f"{cc}/fixed_frame", "base_link"))
         self.tip = rospy.get_param("~tip_frame", rospy.get_param(f"{cc}/eef_frame", "tool0"))
         self._lock = threading.Lock()
         self._status: ContactControlStatus | None = None
+        self._jog: JogStatus | None = None
         self._push: WrenchStamped | None = None
         self._reference = Trail()
         self._tool = Trail()
@@ -53,6 +55,7 @@ class StackMarkers:
         self._subs = [
             rospy.Subscriber(f"{cc}/status", ContactControlStatus, self._on_status, queue_size=1),
             rospy.Subscriber(f"{cc}/path_reference", PathReference, self._on_reference, queue_size=10),
+            rospy.Subscriber(f"{jog}/status", JogStatus, self._on_jog, queue_size=1),
             rospy.Subscriber(rospy.get_param("~push_topic", "/mujoco_driver/active_push"), WrenchStamped,
                              self._on_push, queue_size=1),
         ]
@@ -74,6 +77,10 @@ class StackMarkers:
     def _on_status(self, msg: ContactControlStatus) -> None:
         with self._lock:
             self._status = msg
+
+    def _on_jog(self, msg: JogStatus) -> None:
+        with self._lock:
+            self._jog = msg
 
     def _on_push(self, msg: WrenchStamped) -> None:
         with self._lock:
@@ -101,7 +108,7 @@ class StackMarkers:
         now = rospy.get_time()
         tip = self._tip_in(self.base)
         with self._lock:
-            status, push = self._status, self._push
+            status, push, jog = self._status, self._push, self._jog
             if tip is not None and now - self._last_reference < REPLAYING:
                 self._tool.add(now, tip)
             reference, tool = list(self._reference.points), list(self._tool.points)
@@ -124,6 +131,10 @@ class StackMarkers:
                      for a in status.axes]
             text = marker("laws", Marker.TEXT_VIEW_FACING, self.base, _colour(1, 1, 1))
             text.text = axis_text(lines, status.safety_name, status.message)
+            cap = "" if jog is None else cap_text(jog.speed_cap, jog.body_region,
+                                                  jog.code == JogStatus.COLLABORATIVE_SPEED_CAP)
+            if cap:
+                text.text += "\n" + cap
             text.scale.z = 0.03
             if tip is not None:
                 text.pose.position = Point(tip[0], tip[1], tip[2] + TEXT_ABOVE)
