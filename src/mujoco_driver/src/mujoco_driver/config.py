@@ -163,6 +163,19 @@ class Hole:
 
 
 @dataclass(frozen=True)
+class Hand:
+    """A person's hand lying on the obstacle block (README, Fixtures): a box of ISO/TS 15066's hand mass on a
+    vertical slide joint whose spring is the hand's tissue (Annex A: 0.6 kg, 75 N/mm), backed by the block:
+    pressed more than `travel` it is on the bone (the joint's limit)."""
+
+    mass: float = 0.6  # [kg] ISO/TS 15066 Table A.3
+    stiffness: float = 75e3  # [N/m] ISO/TS 15066 Table A.3 (75 N/mm)
+    size: tuple[float, float, float] = (0.09, 0.09, 0.03)  # [m] a palm (a guess at a hand's size)
+    travel: float = 0.015  # [m] tissue compression before bone (a guess: 1125 N at 75 N/mm)
+    damping_ratio: float = 0.2  # of the spring-mass (a guess: tissue is well damped)
+
+
+@dataclass(frozen=True)
 class ServoConfig:
     """Joint position servos (PD with velocity feed-forward, like an industrial joint controller).
 
@@ -212,6 +225,7 @@ class SceneConfig:
     wrench_noise: NoiseConfig = field(default_factory=NoiseConfig)
     held_joints: Mapping[str, float] = field(default_factory=dict)
     hole: Hole | None = None
+    hand: Hand | None = None
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> SceneConfig:

@@ -15,7 +15,7 @@ from typing import Any
 from compliant_common.errors import StackError
 from compliant_common.schema import Param, SchemaError, param, schema_of
 
-from mujoco_driver.config import Hole, PerJoint, SceneConfig, load_scene_config
+from mujoco_driver.config import Hand, Hole, PerJoint, SceneConfig, load_scene_config
 from mujoco_driver.fixtures import hole_offset
 
 __all__ = ["PARAMETERS", "DriverParamError", "DriverSettings", "load_scene", "urdf_root_link"]
@@ -77,9 +77,9 @@ class DriverSettings:
         0.01, unit="s", ge=0.0, doc="period of `~eef_pose` (ground truth for plots); 0 = with `joint_states`"
     )
     fixture: str = param(
-        "none", choices=("none", "hole"),
-        doc="hole: a plate with a square, chamfered hole on the obstacle block, for a square peg tool "
-        "(README, Fixtures)",
+        "none", choices=("none", "hole", "hand"),
+        doc="hole: a plate with a square, chamfered hole on the obstacle block, for a square peg tool; hand: "
+        "a person's hand (ISO/TS 15066: 0.6 kg, 75 N/mm) lying on the block (README, Fixtures)",
     )
     hole_offset: tuple[float, ...] = param(
         (0.0, 0.0, 0.0), type="floats", length=3, unit="m, m, rad",
@@ -253,4 +253,8 @@ def load_scene(settings: DriverSettings) -> SceneConfig:
         hole = Hole(peg=settings.peg_width, clearance=settings.hole_clearance, depth=settings.hole_depth,
                     chamfer=settings.hole_chamfer, offset=offset)  # type: ignore[arg-type]
         cfg = dataclasses.replace(cfg, hole=hole)
+    if settings.fixture == "hand":
+        if cfg.obstacle is None:
+            raise DriverParamError("~fixture hand: the scene has no obstacle block to lay the hand on")
+        cfg = dataclasses.replace(cfg, hand=Hand())
     return cfg

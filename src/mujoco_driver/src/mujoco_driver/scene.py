@@ -30,7 +30,7 @@ import numpy as np
 from compliant_common.errors import StackError
 from control_stack.description import DescriptionError, parse_robot
 
-from mujoco_driver.config import SceneConfig
+from mujoco_driver.config import Box, Hand, SceneConfig
 from mujoco_driver.fixtures import hole_boxes
 from mujoco_driver.meshes import LinkGeometry, prepare_collision
 
@@ -44,6 +44,7 @@ _log = logging.getLogger(__name__)
 _INPUT = mujoco.mjtCtrlInput
 PID_INPUTS = int(_INPUT.mjINPUT_POS | _INPUT.mjINPUT_VEL | _INPUT.mjINPUT_FF)  # ctrl: [pos, vel, ff]
 FT_SITE = "ft_sensor_site"
+HAND_BODY, HAND_JOINT = "person_hand", "person_hand_slide"  # the hand fixture (config.Hand)
 FORCE_SENSOR = "ft_force"
 TORQUE_SENSOR = "ft_torque"
 _INTEGRATORS = {
@@ -274,6 +275,23 @@ def _add_environment(spec: mujoco.MjSpec, cfg: SceneConfig) -> None:
                 part = world.add_geom(name=box.name, type=mujoco.mjtGeom.mjGEOM_BOX, size=list(box.half),
                                       pos=list(box.pos), quat=list(box.quat), rgba=[0.7, 0.7, 0.75, 1.0])
                 part.solimp = OBSTACLE_SOLIMP
+        if cfg.hand is not None:
+            _add_hand(spec, obs, cfg.hand)
+
+
+def _add_hand(spec: mujoco.MjSpec, block: Box, hand: Hand) -> None:
+    """The hand on the block's top centre (config.Hand): its spring holds it there, weightless (gravcomp)."""
+    top = block.position[2] + block.size[2] / 2.0
+    body = spec.worldbody.add_body(name=HAND_BODY, pos=[block.position[0], block.position[1],
+                                                        top + hand.size[2] / 2.0])
+    body.gravcomp = 1.0
+    body.add_joint(name=HAND_JOINT, type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0.0, 0.0, 1.0],
+                   stiffness=hand.stiffness, springref=0.0, range=[-hand.travel, 0.05],
+                   limited=mujoco.mjtLimited.mjLIMITED_TRUE,
+                   damping=2.0 * hand.damping_ratio * math.sqrt(hand.stiffness * hand.mass))
+    body.add_geom(name=HAND_BODY, type=mujoco.mjtGeom.mjGEOM_BOX, size=[a / 2.0 for a in hand.size],
+                  mass=hand.mass, rgba=[0.9, 0.7, 0.55, 1.0])
+    spec.add_exclude(bodyname1="world", bodyname2=HAND_BODY)  # it sinks into the block as it is pressed
 
 
 OVERLAP_SAMPLES = 8  # postures (the start pose and fixed pseudo-random ones) a pair must touch in all of
