@@ -134,3 +134,29 @@ def test_a_jog_below_the_cap_and_a_pure_rotation_are_left_alone():
     assert 1.0 < jog.speed_cap.last.speed < math.inf
     trace = arm.run(100, (0.0, 0.0, 0.0, 0.0, 0.0, 0.5))  # the tip's origin does not move
     assert trace.status[-1] == StatusCode.NO_WARNING and jog.speed_cap.last.speed == math.inf
+
+
+@pytest.mark.parametrize("robot", [UR5, PANDA], ids=lambda r: r.name)
+def test_the_inverse_mass_reused_within_a_hundredth_of_a_radian_moves_the_cap_under_two_tenths_percent(robot):
+    jog = make_jog(robot, collaborative_region="hand")
+    cap, region = jog.speed_cap, REGIONS["hand"]
+    rng = np.random.default_rng(1)
+    worst = 0.0
+    for _ in range(300):
+        q0 = np.asarray(robot.start) + rng.normal(0.0, 0.3, len(robot.start))
+        q1 = q0 + rng.choice([-1.0, 1.0], len(q0)) * 0.0099  # every joint just inside the reuse distance
+        u = rng.normal(size=3)
+        masses = []
+        for q in (q0, q1):
+            cap.configure("hand", 0.0)  # forget: computed here
+            g = jog.solver.geometry(q.tolist())
+            masses.append(cap.robot_mass(g.q, g.J, u))
+        worst = max(worst, abs(max_speed(region, masses[1]) / max_speed(region, masses[0]) - 1.0))
+    assert worst < 0.002
+    # And it is reused there: the mass a hundredth of a radian away is the one computed before.
+    g = jog.solver.geometry(list(robot.start))
+    first = cap.robot_mass(g.q, g.J, np.array([1.0, 0.0, 0.0]))
+    near = jog.solver.geometry((np.asarray(robot.start) + 0.009).tolist())
+    assert cap.robot_mass(near.q, near.J, np.array([1.0, 0.0, 0.0])) == first
+    far = jog.solver.geometry((np.asarray(robot.start) + 0.02).tolist())
+    assert cap.robot_mass(far.q, far.J, np.array([1.0, 0.0, 0.0])) != first

@@ -2,8 +2,8 @@
 "Health").
 
 ERROR: no joint state or a stale one, a halt at a singularity or a joint limit (the arm is held). WARN:
-slowing for a singularity or a joint limit, joint velocities scaled down, the contact guard acting, an
-invalid command.
+slowing for a singularity or a joint limit, joint velocities scaled down, the contact guard acting, a clamp
+being released, an invalid command.
 OK: following commands (also at the collaborative speed cap: the values name the cap and the body region),
 idle (no command), paused for a named-pose move.
 """
@@ -26,6 +26,7 @@ LEVELS = {
     StatusCode.DECELERATE_FOR_JOINT_LIMIT: WARN,
     StatusCode.JOINT_VELOCITY_SCALED: WARN,
     StatusCode.CONTACT_GUARD: WARN,
+    StatusCode.CLAMP_RELEASE: WARN,
     StatusCode.INVALID_COMMAND: WARN,
 }
 _WORDS = {StatusCode.NO_WARNING: "following commands", StatusCode.STALE_COMMAND: "idle (no command)",

@@ -227,6 +227,12 @@ class JogSettings:
         doc="body region of ISO/TS 15066 the tip's speed is capped for, in the direction it moves (README: "
         "[collaborative speed cap](#collaborative-speed-cap)); `off`: no cap",
     )
+    clamp_hold: float = _pos(
+        0.05, "s", "a contact force at or over the region's quasi-static limit this long is a clamp (README: "
+        "[clamping](#clamping)); shorter peaks (a strike) are not",
+    )
+    clamp_release_speed: float = _pos(0.02, "m/s", "a clamp is released backing off along the force at this")
+    clamp_release_force: float = _pos(10.0, "N", "the release ends below this contact force")
     collaborative_payload: float = param(
         0.0, unit="kg", ge=0.0,
         doc="mass at the tip that the URDF lacks (a grasped part), added to the arm's effective mass",
@@ -340,6 +346,7 @@ TUNABLE = (
     "singularity_threshold", "hard_stop_singularity_threshold", "pinv_damping", "pinv_damping_threshold",
     "contact_guard_max_force", "contact_guard_slow_force", "contact_guard_slow_speed",
     "contact_guard_timeout", "contact_guard_relief_speed", "collaborative_region", "collaborative_payload",
+    "clamp_hold", "clamp_release_speed", "clamp_release_force",
 )
 
 

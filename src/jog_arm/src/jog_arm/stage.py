@@ -20,6 +20,8 @@ from typing import NamedTuple
 
 from compliant_common.typedefs import FloatArray
 
+from jog_arm.body_regions import OFF, region_named
+from jog_arm.clamp import ClampRelease
 from jog_arm.contact_guard import ContactGuard
 from jog_arm.jog_calcs import JogCalcs, Point
 from jog_arm.model_frames import ModelFrames
@@ -34,6 +36,7 @@ ContactSource = Callable[[], "tuple[Sequence[float], str, float] | None"]
 
 NOTE_SHOWN_FOR = 1.0  # [s] a clock jump stays in the status at least this long
 MISSED_WARNING_EVERY = 10.0  # [s] between warnings about missed cycles
+PUSH_GAP = 0.1  # [s] a push stopped by the contact guard counts as going on this long after its last twist
 # While the contact guard cuts an outside twist, the status says so instead of these (why the arm stops).
 _GUARD_OUTRANKS = (StatusCode.NO_WARNING, StatusCode.JOINT_VELOCITY_SCALED, StatusCode.STALE_COMMAND,
                    StatusCode.COLLABORATIVE_SPEED_CAP)
@@ -123,6 +126,10 @@ class JogStage:
         self._contact_source: ContactSource = contact or (lambda: self._contact)
         self._guard_note = ""
         self._guard_acted = False
+        self.clamp = ClampRelease(math.inf, math.inf, s.clamp_hold, s.clamp_release_speed,
+                                  s.clamp_release_force)
+        self._push_stopped = -math.inf  # when the contact guard last stopped a push at its limit
+        self._clamp_limits(s)
 
     def retune(self, settings: JogSettings) -> None:
         """Live tuning: settings validated by `JogSettings.retuned` (TUNABLE keys only), applied from the next
@@ -133,6 +140,14 @@ class JogStage:
                               settings.contact_guard_relief_speed)
         self.jog.retune(settings)
         self.settings = settings
+        self._clamp_limits(settings)
+
+    def _clamp_limits(self, s: JogSettings) -> None:
+        """The clamp's limit is the body region's quasi-static force (no region: no clamp release)."""
+        c = self.clamp
+        c.limit = math.inf if s.collaborative_region == OFF else region_named(s.collaborative_region).force
+        c.hold, c.speed, c.release = s.clamp_hold, s.clamp_release_speed, s.clamp_release_force
+        c.push_limit = s.contact_guard_max_force if s.contact_guard_enabled else math.inf
 
     # --- inputs ---
     def on_joint_state(self, names: Sequence[str], positions: Sequence[float], t: float) -> bool:
@@ -168,6 +183,8 @@ class JogStage:
             makes the arm stop (see `JogCalcs.set_command`).
         """
         frame = frame.lstrip("/")
+        if self.clamp.active:  # releasing a clamp: no command moves the arm until it is released
+            return None
         if (outside if guarded is None else guarded) and self.guard is not None:
             twist = self._guarded(twist, frame or self.settings.default_cmd_frame, t)
         result = self.jog.set_command(twist, frame, t)
@@ -208,10 +225,52 @@ class JogStage:
                 else:
                     force = tuple(sum(pose[r][c] * raw[c] for c in range(3)) for r in range(3))
         result = self.guard.limit(twist, force, age)
+        if result.blocked and result.force >= self.guard.max_force:
+            self._push_stopped = t
         if result.message != self._guard_note and result.acted:
             self.notes.append(("warn_throttle", result.message))
         self._guard_note, self._guard_acted = result.message, result.acted
         return result.twist
+
+    def _release_clamp(self, t: float) -> bool:
+        """A clamp (clamp.ClampRelease) is released this cycle: the retreat along the force is the command
+        (in `planning_frame`); when it ends the arm stops. Whether one is being released."""
+        contact, clamp = self._contact_source(), self.clamp
+        was = clamp.active
+        retreat = None
+        if contact is not None and clamp.limit < math.inf:
+            raw, frame, measured = contact
+            pushed = t - self._push_stopped <= max(clamp.hold, PUSH_GAP)  # twists come at 10 Hz or more
+            retreat = clamp.check(raw, t - measured, self.settings.contact_guard_timeout, t, pushed)
+        if retreat is None:
+            if was:
+                clamp.active = False
+                self.jog.drop_command(f"clamp released (peak {clamp.peak:.0f} N)")
+                self._fault_note = f"clamp released below {clamp.release:g} N (peak {clamp.peak:.0f} N)"
+                self._fault_shown_until = self._monotonic() + NOTE_SHOWN_FOR
+                self.notes.append(("warn", self._fault_note))
+            return False
+        s = self.settings
+        root, v = s.planning_frame, retreat
+        if frame and frame != root:
+            try:
+                pose = self.frames.pose(frame, root)
+            except LookupError:
+                pose = None
+            if pose is None:  # which way is away is unknown: hold (the contact guard stops outside twists)
+                clamp.active = False
+                return False
+            v = (pose[0][0] * v[0] + pose[0][1] * v[1] + pose[0][2] * v[2],
+                 pose[1][0] * v[0] + pose[1][1] * v[1] + pose[1][2] * v[2],
+                 pose[2][0] * v[0] + pose[2][1] * v[1] + pose[2][2] * v[2])
+        if not was:
+            crossed = clamp.limit_words(s.collaborative_region)
+            self.notes.append(("warn", f"clamp: {clamp.peak:.0f} N, over {crossed} for {clamp.hold:g} s: "
+                               "backing off along the force"))
+        unit = s.scale_linear if s.command_in_type == "unitless" else 1.0  # m/s either way
+        self.jog.set_command((v[0] / unit, v[1] / unit, v[2] / unit, 0.0, 0.0, 0.0), root, t)
+        self._from_topic = False
+        return True
 
     # --- time ---
     def next_due(self) -> float:
@@ -246,6 +305,7 @@ class JogStage:
             self._next_missed_warning = t + MISSED_WARNING_EVERY
             self.notes.append(("warn", f"{self._cycles.missed} publish cycles missed so far (longest gap "
                                f"{self._cycles.max_gap * 1e3:.1f} ms, period {self._period * 1e3:g} ms)"))
+        releasing = self._release_clamp(t)
         out = self.jog.step(t)
         ahead: tuple[Point, ...] = ()
         if out.publish and self._points > 1:
@@ -253,6 +313,12 @@ class JogStage:
         status, message = out.status, out.message
         if self._guard_acted and self._from_topic and status in _GUARD_OUTRANKS:
             status, message = StatusCode.CONTACT_GUARD, self._guard_note
+        if releasing:
+            c = self.clamp
+            status, message = StatusCode.CLAMP_RELEASE, (
+                f"clamp: up to {c.peak:.0f} N, over {c.limit_words(self.settings.collaborative_region)} "
+                f"for {c.hold:g} s: backing off along the force at {c.speed:g} m/s until below "
+                f"{c.release:g} N")
         if self._fault_note:
             if self._monotonic() < self._fault_shown_until:
                 message = f"{self._fault_note}; {message}"
@@ -321,6 +387,6 @@ def log_level(status: StatusCode) -> str:
     if status in (StatusCode.NO_WARNING, StatusCode.STALE_COMMAND, StatusCode.JOINT_VELOCITY_SCALED):
         return "debug"
     if status in (StatusCode.PAUSED, StatusCode.NO_JOINT_STATE, StatusCode.CONTACT_GUARD,
-                  StatusCode.COLLABORATIVE_SPEED_CAP):
+                  StatusCode.COLLABORATIVE_SPEED_CAP):  # CLAMP_RELEASE: warn
         return "info"
     return "warn"

@@ -24,6 +24,7 @@ class StatusCode(IntEnum):
     STALE_JOINT_STATE = 10
     CONTACT_GUARD = 11
     COLLABORATIVE_SPEED_CAP = 12
+    CLAMP_RELEASE = 13
 
 
 def motion_status(condition: float, s_sing: float, s_pos: float, s_vel: float,

@@ -1,0 +1,78 @@
+"""Clamp release (ISO/TS 15066; the package README, *Clamping*): a contact force at or over the body region's
+quasi-static limit for `hold` seconds is a clamp (a person pinned between the tool and something), and so
+is one at or over `push_limit` (the contact guard's) for `hold` while a push into it is being stopped (the
+arm overshot the guard: it pins what it touched). The arm then backs off along the measured force at
+`speed` until the force is below `release`, whatever it was commanded, and stops. A shorter peak (a strike,
+a spike) is not a clamp. No ROS here.
+
+Without a fresh, finite force the direction away is unknown: nothing is released, and the command stands
+(the contact guard stops outside twists on such a force).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+__all__ = ["ClampRelease"]
+
+
+class ClampRelease:
+    """Watches the contact force each cycle; `check` gives the retreat while a clamp is released.
+
+    Args:
+        limit: |F| [N] at or over which a sustained contact is a clamp (the region's quasi-static force).
+        push_limit: the same while a push into the contact is being stopped (the contact guard's limit).
+        hold: how long [s] |F| must stay at or over `limit`.
+        speed: retreat speed [m/s] along the force.
+        release: the retreat ends below this |F| [N].
+    """
+
+    def __init__(self, limit: float, push_limit: float, hold: float, speed: float, release: float) -> None:
+        self.limit, self.push_limit = limit, push_limit
+        self.hold, self.speed, self.release = hold, speed, release
+        self._over_since: float | None = None
+        self.active = False
+        self.peak = 0.0  # the largest |F| of the clamp being released [N]
+        self.by_push = False  # it was found over `push_limit` (not over `limit`)
+
+    def limit_words(self, region: str) -> str:
+        """Which limit the clamp being released crossed, in words."""
+        if self.by_push:
+            return f"the contact guard's {self.push_limit:g} N while a push into it was stopped"
+        return f"the {region}'s {self.limit:g} N (ISO/TS 15066)"
+
+    def check(self, force: Sequence[float] | None, age: float, timeout: float, t: float, pushed: bool = False
+              ) -> tuple[float, float, float] | None:
+        """The retreat velocity (along the force, in its frame) [m/s] while a clamp is released, else None.
+
+        Args:
+            force: the contact force on the tool (fx, fy, fz) [N]; None: none received.
+            age: how old it is [s]; older than `timeout` counts as none.
+            t: now [s].
+            pushed: a push into the contact is being stopped now.
+        """
+        if force is None or age > timeout:
+            self._over_since = None
+            return None
+        fx, fy, fz = (float(f) for f in force)
+        magnitude = math.sqrt(fx * fx + fy * fy + fz * fz)
+        if not math.isfinite(magnitude):
+            self._over_since = None
+            return None
+        if self.active:
+            if magnitude < self.release:
+                self.active, self._over_since = False, None
+                return None
+        elif magnitude >= (min(self.limit, self.push_limit) if pushed else self.limit):
+            if self._over_since is None:
+                self._over_since = t
+            if t - self._over_since < self.hold:
+                return None
+            self.active, self.peak, self.by_push = True, 0.0, magnitude < self.limit
+        else:
+            self._over_since = None
+            return None
+        self.peak = max(self.peak, magnitude)
+        k = self.speed / magnitude
+        return (fx * k, fy * k, fz * k)

@@ -1,0 +1,117 @@
+"""Clamp release (ISO/TS 15066): a contact force held over the body region's quasi-static limit, or over the
+contact guard's while a push into it is stopped, is a clamp; the arm backs off along the force until it is
+below 10 N, whatever it is told meanwhile. A short peak is not a clamp. The rules on their own, then in the
+compliant pipeline with a perfect arm pressing a hand of 75 N/mm (ISO/TS 15066's)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from harness.pipeline_cell import DT, Cell
+from jog_arm.clamp import ClampRelease
+from jog_arm.status import StatusCode
+
+pytestmark = pytest.mark.cobot_safety
+
+HAND_STIFFNESS = 75e3  # [N/m] ISO/TS 15066 Annex A
+
+
+def test_a_sustained_force_over_the_limit_is_released_and_a_spike_is_not():
+    clamp = ClampRelease(140.0, 20.0, 0.05, 0.02, 10.0)
+    assert clamp.check((0.0, 0.0, 200.0), 0.0, 0.25, 0.0) is None  # a 200 N sample
+    assert clamp.check((0.0, 0.0, 5.0), 0.0, 0.25, 0.01) is None and not clamp.active  # gone: a spike
+    assert clamp.check((0.0, 0.0, 150.0), 0.0, 0.25, 0.02) is None  # over: the hold starts
+    assert clamp.check((0.0, 0.0, 150.0), 0.0, 0.25, 0.06) is None  # 40 ms: not yet
+    assert clamp.check((0.0, 90.0, 120.0), 0.0, 0.25, 0.07) == pytest.approx((0.0, 0.012, 0.016))  # along F
+    assert clamp.active and "the hand's 140 N" in clamp.limit_words("hand")
+    assert clamp.check((0.0, 0.0, 11.0), 0.0, 0.25, 0.3) == pytest.approx((0.0, 0.0, 0.02))  # still >= 10 N
+    assert clamp.check((0.0, 0.0, 9.0), 0.0, 0.25, 0.4) is None and not clamp.active  # released
+    assert clamp.check((0.0, 0.0, 150.0), 0.0, 0.25, 0.41) is None  # a new clamp needs a new hold
+
+
+def test_while_a_push_is_stopped_the_guard_limit_counts_and_no_force_releases_nothing():
+    clamp = ClampRelease(140.0, 20.0, 0.05, 0.02, 10.0)
+    for t in (0.0, 0.03):
+        assert clamp.check((0.0, 0.0, 60.0), 0.0, 0.25, t) is None  # 60 N: under the hand's limit
+    assert clamp.check((0.0, 0.0, 60.0), 0.0, 0.25, 0.04, pushed=True) is None
+    assert clamp.check((0.0, 0.0, 60.0), 0.0, 0.25, 0.10, pushed=True) is not None
+    assert clamp.by_push and "contact guard's 20 N" in clamp.limit_words("hand")
+    other = ClampRelease(140.0, 20.0, 0.05, 0.02, 10.0)
+    assert other.check((0.0, 0.0, 300.0), 0.5, 0.25, 0.0) is None  # stale: which way is away is unknown
+    assert other.check((math.nan, 0.0, 300.0), 0.0, 0.25, 0.1) is None
+    assert other.check(None, 0.0, 0.25, 0.2) is None and not other.active
+
+
+class HandCell:
+    """The UR5's pipeline and a perfect arm whose tool presses a hand (75 N/mm) under it."""
+
+    def __init__(self, robot: str, pressed: float) -> None:
+        self.cell = c = Cell(robot)
+        for _ in range(150):  # zeroed on the tool's weight
+            c.step((0.0, 0.0, 0.0))
+        assert c.pipeline.contact.ctrl.last_result.safety == 0
+        self.surface = self.tip_z() + pressed  # the hand's top: `pressed` [m] above the tool tip
+        self.forces: list[float] = []
+        self.statuses: list[tuple[int, str]] = []
+
+    def tip_z(self) -> float:
+        return float(self.cell.pose("tool_tip")[2, 3])
+
+    def force(self) -> float:
+        return HAND_STIFFNESS * max(0.0, self.surface - self.tip_z())
+
+    def run(self, seconds: float, twist: tuple[float, ...] | None = None) -> None:
+        c, p = self.cell, self.cell.pipeline
+        for _ in range(round(seconds / DT)):
+            f = self.force()
+            self.forces.append(f)
+            c.step((0.0, 0.0, f))
+            if twist is not None:
+                c._apply(p.on_twist(twist, c.cc.fixed_frame, c.t, c.t))
+            last = p.jog.last_cycle
+            if last is not None:
+                self.statuses.append((int(last.status), last.message))
+
+
+@pytest.mark.parametrize("robot", ["ur5", "panda"])
+def test_a_hand_pressed_at_225_newtons_is_released_below_10_newtons_within_a_second(robot):
+    hand = HandCell(robot, pressed=0.003)  # 225 N from the start, nothing commanded
+    z0 = hand.tip_z()
+    hand.run(1.0)
+    forces = np.array(hand.forces)
+    below = int(np.argmax(forces < 10.0))
+    assert forces[0] == pytest.approx(225.0, rel=0.01) and forces[below] < 10.0 and below > 0
+    print(f"\n{robot}: 225 N released below 10 N after {below * DT:.3f} s, tool up "
+          f"{(hand.tip_z() - z0) * 1e3:.2f} mm")
+    assert below * DT < 1.0
+    assert max(forces[below:]) < 10.0  # and it stays released
+    assert 0.0025 < hand.tip_z() - z0 < 0.006  # backed off out of the hand, not far beyond
+    codes = [code for code, _ in hand.statuses]
+    assert StatusCode.CLAMP_RELEASE in codes
+    message = next(m for code, m in hand.statuses if code == StatusCode.CLAMP_RELEASE)
+    assert "hand's 140 N" in message and "below 10 N" in message
+    assert any("clamp released" in m for _, m in hand.statuses[codes.index(StatusCode.CLAMP_RELEASE):])
+
+
+def test_a_100_newton_press_is_not_a_clamp():
+    hand = HandCell("ur5", pressed=0.0013)  # 98 N: under the hand's 140 N, nothing pushing
+    z0 = hand.tip_z()
+    hand.run(0.5)
+    assert abs(hand.tip_z() - z0) < 1e-6 and StatusCode.CLAMP_RELEASE not in [c for c, _ in hand.statuses]
+
+
+def test_a_push_into_the_hand_that_overshoots_the_guard_is_released_though_the_push_goes_on():
+    hand = HandCell("ur5", pressed=-0.002)  # the hand 2 mm below the tool
+    hand.run(0.4, twist=(0.0, 0.0, -0.1, 0.0, 0.0, 0.0))  # an outside jog down at 0.1 m/s, held
+    forces = np.array(hand.forces)
+    peak = int(np.argmax(forces))
+    print(f"\nUR5 jog at 0.1 m/s into the hand: peak {forces[peak]:.0f} N, then {max(forces[-100:]):.1f} N")
+    assert forces[peak] > 20.0  # the guard (20 N) could not stop the arm in time
+    released = peak + int(np.argmax(forces[peak:] < 10.0))
+    assert forces[released] < 10.0 and (released - peak) * DT < 1.0  # released while the key is held
+    assert StatusCode.CLAMP_RELEASE in [c for c, _ in hand.statuses]
+    # The key still held then presses again, slowly, as the contact guard lets it (9 mm/s at 3 N): it settles
+    # under the guard's 20 N after a brief overshoot (24.7 N), far from another clamp.
+    assert max(forces[released:]) < 30.0 and forces[-1] < 20.0
