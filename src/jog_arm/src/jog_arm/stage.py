@@ -36,7 +36,9 @@ ContactSource = Callable[[], "tuple[Sequence[float], str, float] | None"]
 
 NOTE_SHOWN_FOR = 1.0  # [s] a clock jump stays in the status at least this long
 MISSED_WARNING_EVERY = 10.0  # [s] between warnings about missed cycles
-PUSH_GAP = 0.1  # [s] a push stopped by the contact guard counts as going on this long after its last twist
+# [s] an outside twist stream counts as going on until it has been silent this long (twists come at 10 Hz
+# or more): a push the contact guard stopped, and after a clamp the stream that must pause first
+PUSH_GAP = 0.1
 # While the contact guard cuts an outside twist, the status says so instead of these (why the arm stops).
 _GUARD_OUTRANKS = (StatusCode.NO_WARNING, StatusCode.JOINT_VELOCITY_SCALED, StatusCode.STALE_COMMAND,
                    StatusCode.COLLABORATIVE_SPEED_CAP)
@@ -129,6 +131,8 @@ class JogStage:
         self.clamp = ClampRelease(math.inf, math.inf, s.clamp_hold, s.clamp_release_speed,
                                   s.clamp_release_force)
         self._push_stopped = -math.inf  # when the contact guard last stopped a push at its limit
+        self._last_guarded = -math.inf  # when the last guarded (outside) twist arrived
+        self._await_pause = False  # after a clamp: guarded twists are ignored until their stream pauses
         self._clamp_limits(s)
 
     def retune(self, settings: JogSettings) -> None:
@@ -183,9 +187,15 @@ class JogStage:
             makes the arm stop (see `JogCalcs.set_command`).
         """
         frame = frame.lstrip("/")
+        is_guarded = outside if guarded is None else guarded
+        if is_guarded:
+            last, self._last_guarded = self._last_guarded, t
+            if self._await_pause and t - last < PUSH_GAP:  # the stream that pushed into the clamp goes on
+                return None
+            self._await_pause = False
         if self.clamp.active:  # releasing a clamp: no command moves the arm until it is released
             return None
-        if (outside if guarded is None else guarded) and self.guard is not None:
+        if is_guarded and self.guard is not None:
             twist = self._guarded(twist, frame or self.settings.default_cmd_frame, t)
         result = self.jog.set_command(twist, frame, t)
         self._from_topic = outside
@@ -246,7 +256,9 @@ class JogStage:
             if was:
                 clamp.active = False
                 self.jog.drop_command(f"clamp released (peak {clamp.peak:.0f} N)")
-                self._fault_note = f"clamp released below {clamp.release:g} N (peak {clamp.peak:.0f} N)"
+                self._await_pause = True
+                self._fault_note = (f"clamp released below {clamp.release:g} N (peak {clamp.peak:.0f} N); "
+                                    "outside commands wait until they pause (let go of the key)")
                 self._fault_shown_until = self._monotonic() + NOTE_SHOWN_FOR
                 self.notes.append(("warn", self._fault_note))
             return False
