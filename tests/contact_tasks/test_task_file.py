@@ -59,6 +59,11 @@ def test_a_valid_task_loads_with_its_steps_laws_pattern_and_exits_in_order():
     assert (task.force_ceiling, task.approach, task.retract.distance) == (25.0, "-z", 0.02)
 
 
+def test_a_task_may_name_the_body_region_jog_arm_guards_while_it_runs():
+    assert parse_task(GOOD, "probe.yaml").body_region == ""  # the robot's own
+    assert parse_task(with_change("body_region", "face"), "probe.yaml").body_region == "face"
+
+
 def test_every_shipped_task_file_loads():
     files = sorted(SHIPPED.glob("*.yaml"))
     assert files
@@ -108,6 +113,7 @@ BAD = [
     ("task", None, "task: give the task a name"),
     ("steps", {}, "steps: a task needs at least one step"),
     ("steps.down", [1, 2], "steps.down: expected a mapping of keys"),
+    ("body_region", "hands", "body_region: must be one of ('', 'off', 'skull'"),
 ]
 
 

@@ -1,7 +1,7 @@
 """End to end: task_server's ~execute on the simulated UR5. A task touches the block under the tool, presses
 8 N and rubs 20 mm along X (a line pattern with the path law on X and Y); the result names its steps and
 peaks. Cancelled mid-rub the arm stops and the action says so; a bad task file is refused with its key and
-nothing moves."""
+nothing moves. A task's body region (ISO/TS 15066) holds on jog_arm while it runs, the robot's after."""
 
 from __future__ import annotations
 
@@ -41,6 +41,16 @@ steps:
     exits:
       - {when: pattern_done, succeed: rubbed 20 mm}
       - {when: timeout, after: 30.0, fail: too slow}
+"""
+
+HOLD = """
+task: hold
+body_region: face
+steps:
+  wait:
+    laws: {z: {law: follower, damping: 2000.0}}
+    exits:
+      - {when: timeout, after: 1.0, succeed: waited}
 """
 
 
@@ -93,4 +103,15 @@ def test_a_task_touches_rubs_at_a_force_and_cancels_and_refuses(ros_node):
         client.send_goal(ExecuteTaskGoal(task="no_such_task"))
         assert client.wait_for_result(rospy.Duration(10.0))
         assert "no_such_task.yaml: cannot read the task file" in client.get_result().message
+
+        # The task's body region holds on jog_arm while it runs; the robot's own comes back after.
+        region = "/jog_arm_server/collaborative_region"
+        assert rospy.get_param(region) == "hand"
+        seen: list[str] = []
+        client.send_goal(ExecuteTaskGoal(task_yaml=HOLD),
+                         feedback_cb=lambda _: seen.append(rospy.get_param(region)))
+        assert client.wait_for_result(rospy.Duration(20.0))
+        assert client.get_result().success, client.get_result().message
+        assert seen and set(seen) == {"face"}
+        assert rospy.get_param(region) == "hand"
         h.stop()

@@ -12,7 +12,7 @@ import math
 import os
 import sys
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import actionlib
 import numpy as np
@@ -33,6 +33,7 @@ from compliant_control_msgs.msg import (
 )
 from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsRequest
 from contact_control.frames import matrix_quaternion, quaternion_matrix
+from dynamic_reconfigure.client import Client
 from geometry_msgs.msg import Point, Pose, Quaternion
 from std_srvs.srv import Trigger
 
@@ -204,13 +205,48 @@ class TaskServer:
         except TaskError as err:
             self._server.set_aborted(ExecuteTaskResult(outcome="refused", message=str(err)), str(err))
             return
-        self._listen()
         try:
-            self._carry_out(task)
+            before = self._set_region(task.body_region) if task.body_region else ""
+        except TaskError as err:
+            self._server.set_aborted(ExecuteTaskResult(outcome="refused", message=str(err)), str(err))
+            return
+        self._listen()
+        answer = self._server.set_aborted, ExecuteTaskResult(outcome="refused", message="shutting down")
+        try:
+            answer = self._carry_out(task)
         finally:
             self._unlisten()
+            if before:  # the robot's own region back before the answer: the caller may act on it at once
+                try:
+                    self._set_region(before)
+                except TaskError as err:
+                    rospy.logerr("task_server: %s", err)
+            send, result = answer
+            send(result, result.message)
 
-    def _carry_out(self, task: Task) -> None:
+    def _set_region(self, region: str) -> str:
+        """jog_arm's collaborative_region set to `region` (dynamic_reconfigure); the one it had.
+
+        Raises:
+            TaskError: jog_arm's reconfiguration is not there or refused it.
+        """
+        try:
+            client = Client(self.s.jog_arm, timeout=self.s.status_timeout)
+            try:
+                before = str(client.get_configuration(timeout=self.s.status_timeout)["collaborative_region"])
+                after = client.update_configuration({"collaborative_region": region})
+            finally:
+                client.close()
+        except (rospy.ROSException, KeyError, TypeError) as err:
+            raise TaskError(f"cannot set the body region {region!r} on {self.s.jog_arm}: {err}") from None
+        if after.get("collaborative_region") != region:
+            raise TaskError(f"{self.s.jog_arm} refused the body region {region!r}")
+        rospy.loginfo("task_server: body region %s (was %s)", region, before)
+        return before
+
+    def _carry_out(self, task: Task) -> tuple[Callable[..., None], ExecuteTaskResult]:
+        """Runs the task; how to answer (the action server's set_succeeded, _aborted or _preempted) and
+        with what."""
         began = rospy.get_time()
         with self._lock:
             self._touched = self._released = False
@@ -223,8 +259,7 @@ class TaskServer:
         elif tool is None:
             why = f"no transform {self.fixed_frame} -> {self.eef_frame}: the tool's pose is unknown"
         if why or tool is None:
-            self._server.set_aborted(ExecuteTaskResult(outcome="refused", message=why), why)
-            return
+            return self._server.set_aborted, ExecuteTaskResult(outcome="refused", message=why)
         self._laws_at = math.inf
         run = TaskRun(task, self.s.path_horizon, self.s.path_horizon_step)
         obs = self._observe(tool)
@@ -261,11 +296,10 @@ class TaskServer:
             self._run, self._last = None, f"last task '{task.name}': {result.outcome}: {result.message}"
         rospy.loginfo("task_server: task '%s' %s: %s", task.name, result.outcome, result.message)
         if command.outcome == SUCCEEDED:
-            self._server.set_succeeded(result, result.message)
-        elif command.outcome in (FAILED, RUNNING):
-            self._server.set_aborted(result, result.message)
-        else:
-            self._server.set_preempted(result, result.message)
+            return self._server.set_succeeded, result
+        if command.outcome in (FAILED, RUNNING):
+            return self._server.set_aborted, result
+        return self._server.set_preempted, result
 
     def _result(self, run: TaskRun) -> ExecuteTaskResult:
         r = run.result

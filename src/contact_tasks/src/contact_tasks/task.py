@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 
 from compliant_common.errors import StackError
 from compliant_common.schema import param, schema_of
+from jog_arm.body_regions import OFF, REGIONS
 
 __all__ = [
     "AXIS_NAMES",
@@ -153,6 +154,7 @@ class Task:
     on_failure: str = ""
     retract: Retract = field(default_factory=Retract)
     description: str = ""
+    body_region: str = ""
 
 
 @dataclass(frozen=True)
@@ -170,6 +172,11 @@ class _TaskKeys:
     force_ceiling: float = param(25.0, unit="N", gt=0.0, doc="|F| above this fails the task at once")
     torque_ceiling: float = param(2.0, unit="Nm", gt=0.0, doc="|T| above this fails the task at once")
     on_failure: str = param("", doc="a step run when the task fails (default: the built-in retract)")
+    body_region: str = param(
+        "", choices=("", OFF, *REGIONS),
+        doc="the body region of ISO/TS 15066 jog_arm caps the speed and releases clamps for while the task "
+        "runs (its `collaborative_region`, set back afterwards); empty: the robot's own",
+    )
     retract: dict[str, object] = param({}, type="mapping", doc="the built-in retract's settings (below)")
     steps: dict[str, object] = param({}, type="mapping", doc="step name -> step (below), in order")
 

@@ -143,6 +143,7 @@ class _Parser:
             on_failure=str(keys.get("on_failure", "")),
             retract=retract,
             description=str(keys.get("description", "")),
+            body_region=str(keys.get("body_region", "")),
         )
         if not task.name:
             raise _RefusedError("task: give the task a name (task: <name>)")
