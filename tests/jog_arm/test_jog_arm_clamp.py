@@ -116,6 +116,9 @@ def test_a_push_into_the_hand_that_overshoots_the_guard_is_released_though_the_p
     # The key still held moves nothing after the clamp: it must be let go of first.
     assert max(forces[released:]) < 10.0
     assert any("let go of the key" in m for _, m in hand.statuses[released:])
+    z = hand.tip_z()
+    hand.run(0.2, twist=(0.0, 0.0, 0.02, 0.0, 0.0, 0.0))  # another key at once, away from the hand: moves
+    assert hand.tip_z() > z + 0.002
     hand.run(0.2)  # let go
-    hand.run(0.3, twist=(0.0, 0.0, -0.01, 0.0, 0.0, 0.0))  # pressed again, slowly: the guard's press
+    hand.run(1.2, twist=(0.0, 0.0, -0.01, 0.0, 0.0, 0.0))  # pressed again, slowly: the guard's press
     assert 2.0 < hand.forces[-1] < 20.0

@@ -132,7 +132,8 @@ class JogStage:
                                   s.clamp_release_force)
         self._push_stopped = -math.inf  # when the contact guard last stopped a push at its limit
         self._last_guarded = -math.inf  # when the last guarded (outside) twist arrived
-        self._await_pause = False  # after a clamp: guarded twists are ignored until their stream pauses
+        self._await_pause = False  # after a clamp: pushes into it are ignored until their stream pauses
+        self._away = (0.0, 0.0, 0.0)  # the last clamp's retreat direction (planning_frame)
         self._clamp_limits(s)
 
     def retune(self, settings: JogSettings) -> None:
@@ -190,8 +191,8 @@ class JogStage:
         is_guarded = outside if guarded is None else guarded
         if is_guarded:
             last, self._last_guarded = self._last_guarded, t
-            if self._await_pause and t - last < PUSH_GAP:  # the stream that pushed into the clamp goes on
-                return None
+            if self._await_pause and t - last < PUSH_GAP and self._into_clamp(twist, frame):
+                return None  # the stream that pushed into the clamp goes on: it must pause first
             self._await_pause = False
         if self.clamp.active:  # releasing a clamp: no command moves the arm until it is released
             return None
@@ -258,7 +259,7 @@ class JogStage:
                 self.jog.drop_command(f"clamp released (peak {clamp.peak:.0f} N)")
                 self._await_pause = True
                 self._fault_note = (f"clamp released below {clamp.release:g} N (peak {clamp.peak:.0f} N); "
-                                    "outside commands wait until they pause (let go of the key)")
+                                    "pushes into it wait until they pause (let go of the key)")
                 self._fault_shown_until = self._monotonic() + NOTE_SHOWN_FOR
                 self.notes.append(("warn", self._fault_note))
             return False
@@ -279,10 +280,29 @@ class JogStage:
             crossed = clamp.limit_words(s.collaborative_region)
             self.notes.append(("warn", f"clamp: {clamp.peak:.0f} N, over {crossed} for {clamp.hold:g} s: "
                                "backing off along the force"))
+        self._away = v
         unit = s.scale_linear if s.command_in_type == "unitless" else 1.0  # m/s either way
         self.jog.set_command((v[0] / unit, v[1] / unit, v[2] / unit, 0.0, 0.0, 0.0), root, t)
         self._from_topic = False
         return True
+
+    def _into_clamp(self, twist: Sequence[float], frame: str) -> bool:
+        """Whether a twist's linear part pushes toward the last clamp (against its retreat); True when its
+        frame cannot be turned into planning_frame (refused rather than risked)."""
+        root = self.settings.planning_frame
+        frame = frame or self.settings.default_cmd_frame
+        x, y, z = twist[0], twist[1], twist[2]
+        if frame != root:
+            try:
+                r = self.frames.pose(frame, root)
+            except LookupError:
+                r = None
+            if r is None:
+                return True
+            x, y, z = (r[0][0] * x + r[0][1] * y + r[0][2] * z, r[1][0] * x + r[1][1] * y + r[1][2] * z,
+                       r[2][0] * x + r[2][1] * y + r[2][2] * z)
+        a = self._away
+        return x * a[0] + y * a[1] + z * a[2] < 0.0
 
     # --- time ---
     def next_due(self) -> float:
