@@ -234,7 +234,7 @@ class JogStage:
                 if pose is None:  # cannot say which way is into the contact: treat like no fresh force
                     force, age = (math.nan,) * 3, 0.0
                 else:
-                    force = tuple(sum(pose[r][c] * raw[c] for c in range(3)) for r in range(3))
+                    force = _rotate(pose, raw)
         result = self.guard.limit(twist, force, age)
         if result.blocked and result.force >= self.guard.max_force:
             self._push_stopped = t
@@ -273,9 +273,7 @@ class JogStage:
             if pose is None:  # which way is away is unknown: hold (the contact guard stops outside twists)
                 clamp.active = False
                 return False
-            v = (pose[0][0] * v[0] + pose[0][1] * v[1] + pose[0][2] * v[2],
-                 pose[1][0] * v[0] + pose[1][1] * v[1] + pose[1][2] * v[2],
-                 pose[2][0] * v[0] + pose[2][1] * v[1] + pose[2][2] * v[2])
+            v = _rotate(pose, v)
         if not was:
             crossed = clamp.limit_words(s.collaborative_region)
             self.notes.append(("warn", f"clamp: {clamp.peak:.0f} N, over {crossed} for {clamp.hold:g} s: "
@@ -299,8 +297,7 @@ class JogStage:
                 r = None
             if r is None:
                 return True
-            x, y, z = (r[0][0] * x + r[0][1] * y + r[0][2] * z, r[1][0] * x + r[1][1] * y + r[1][2] * z,
-                       r[2][0] * x + r[2][1] * y + r[2][2] * z)
+            x, y, z = _rotate(r, (x, y, z))
         a = self._away
         return x * a[0] + y * a[1] + z * a[2] < 0.0
 
@@ -412,6 +409,13 @@ class JogStage:
     def add_frame(self, frame: str, parent: str, rotation: FloatArray) -> None:
         """A frame the model lacks, fixed relative to the model frame `parent` (e.g. looked up in tf)."""
         self.jog.add_frame(frame, parent, rotation)
+
+
+def _rotate(r: Sequence[Sequence[float]], v: Sequence[float]) -> tuple[float, float, float]:
+    """A 3-vector turned by the rotation block of `r` (3x3 or 4x4 rows)."""
+    x, y, z = v[0], v[1], v[2]
+    return (r[0][0] * x + r[0][1] * y + r[0][2] * z, r[1][0] * x + r[1][1] * y + r[1][2] * z,
+            r[2][0] * x + r[2][1] * y + r[2][2] * z)
 
 
 def log_level(status: StatusCode) -> str:
