@@ -91,7 +91,7 @@ def test_a_hand_pressed_at_225_newtons_is_released_below_10_newtons_within_a_sec
     codes = [code for code, _ in hand.statuses]
     assert StatusCode.CLAMP_RELEASE in codes
     message = next(m for code, m in hand.statuses if code == StatusCode.CLAMP_RELEASE)
-    assert "hand's 140 N" in message and "below 5 N" in message
+    assert "hand's 140 N" in message and "below 3 N" in message
     assert any("clamp released" in m for _, m in hand.statuses[codes.index(StatusCode.CLAMP_RELEASE):])
 
 

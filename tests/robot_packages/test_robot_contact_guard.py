@@ -94,9 +94,10 @@ def test_jogging_into_the_block_stops_under_the_guard_force_and_backing_out_work
                   f"held {held:.2f} N (guard {GUARD_FORCE:g} N); went down {(z0 - z()) * 1e3:.1f} mm; "
                   f"status {said.code_name}: {said.message}")
             assert z0 - z() > 0.05, "it did not reach the block"
-            assert said.code == JogStatus.CONTACT_GUARD and said.code_name == "CONTACT_GUARD"
-            assert "contact guard" in said.message and "moving away is allowed" in said.message, said.message
             if speed <= JOG_SPEED:
+                assert said.code == JogStatus.CONTACT_GUARD and said.code_name == "CONTACT_GUARD"
+                assert "contact guard" in said.message, said.message
+                assert "moving away is allowed" in said.message, said.message
                 # The guard's slow zone lets the force approach its limit and no further (the driver's raw
                 # reading and contact_control's compensated one, which the guard sees, agree within 0.1 N).
                 # With two nodes the force comes over a topic from another process: a stall of either lets
@@ -106,9 +107,11 @@ def test_jogging_into_the_block_stops_under_the_guard_force_and_backing_out_work
                 assert peak <= GUARD_FORCE + overshoot, peak
                 assert held <= GUARD_FORCE + 0.5, held
             else:
-                # A hard touch (peaks of 57-127 N measured) is then relieved to about the guard force while
-                # the key is held: 19.6-21.6 N by the driver, whose reading differs from the guard's by ~1 N
-                # with the tool strained sideways by friction (12 N along X). Under contact_control's 25 N.
+                # A hard touch (peaks of 57-127 N measured) pins the tool on the block past the guard for
+                # longer than clamp_hold: jog_arm releases it as a clamp (jog_arm README, Clamping) and the
+                # held key presses no more until let go of. (The driver's raw reading minus the start's
+                # weight reads a few newtons above the stack's compensated force with the tool strained.)
+                assert "clamp released" in said.message, said.message
                 assert held <= GUARD_FORCE + 3.0, held
             # Away from the contact: up 2 cm.
             pressed = z()

@@ -233,7 +233,7 @@ class JogSettings:
     )
     clamp_release_speed: float = _pos(0.02, "m/s", "a clamp is released backing off along the force at this")
     clamp_release_force: float = _pos(
-        5.0, "N", "the release ends below this contact force (under 10 N with room for the force's error)"
+        3.0, "N", "the release ends below this contact force (under 10 N with room for the force's error)"
     )
     collaborative_payload: float = param(
         0.0, unit="kg", ge=0.0,

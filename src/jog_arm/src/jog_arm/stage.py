@@ -236,7 +236,8 @@ class JogStage:
                 else:
                     force = _rotate(pose, raw)
         result = self.guard.limit(twist, force, age)
-        if result.blocked and result.force >= self.guard.max_force:
+        if result.blocked and result.force >= self.guard.max_force and force is not None and \
+                _pushes_into(twist, force):
             self._push_stopped = t
         if result.message != self._guard_note and result.acted:
             self.notes.append(("warn_throttle", result.message))
@@ -299,7 +300,7 @@ class JogStage:
                 return True
             x, y, z = _rotate(r, (x, y, z))
         a = self._away
-        return x * a[0] + y * a[1] + z * a[2] < 0.0
+        return _pushes_into((x, y, z), (a[0], a[1], a[2]))
 
     # --- time ---
     def next_due(self) -> float:
@@ -409,6 +410,18 @@ class JogStage:
     def add_frame(self, frame: str, parent: str, rotation: FloatArray) -> None:
         """A frame the model lacks, fixed relative to the model frame `parent` (e.g. looked up in tf)."""
         self.jog.add_frame(frame, parent, rotation)
+
+
+# A push "into" a contact: its linear part within 60 degrees of the direction against the force. A jog
+# sideways along a surface, or one a person's push happens to lean on, is not pressing into it.
+_INTO_COS = 0.5
+
+
+def _pushes_into(twist: Sequence[float], away: Sequence[float]) -> bool:
+    """Whether a twist's linear part points against `away` (a force on the tool, a retreat), within 60 deg."""
+    x, y, z, a, b, c = twist[0], twist[1], twist[2], away[0], away[1], away[2]
+    speed, size = math.sqrt(x * x + y * y + z * z), math.sqrt(a * a + b * b + c * c)
+    return speed > 0.0 and size > 0.0 and -(x * a + y * b + z * c) >= _INTO_COS * speed * size
 
 
 def _rotate(r: Sequence[Sequence[float]], v: Sequence[float]) -> tuple[float, float, float]:
