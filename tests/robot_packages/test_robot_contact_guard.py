@@ -107,11 +107,13 @@ def test_jogging_into_the_block_stops_under_the_guard_force_and_backing_out_work
                 assert peak <= GUARD_FORCE + overshoot, peak
                 assert held <= GUARD_FORCE + 0.5, held
             else:
-                # A hard touch (peaks of 57-127 N measured) pins the tool on the block past the guard for
-                # longer than clamp_hold: jog_arm releases it as a clamp (jog_arm README, Clamping) and the
-                # held key presses no more until let go of. (The driver's raw reading minus the start's
-                # weight reads a few newtons above the stack's compensated force with the tool strained.)
-                assert "clamp released" in said.message, said.message
+                # A hard touch (peaks of 52-127 N measured): the guard backs off while the key is held, or,
+                # when the touch stayed over the guard's force for clamp_hold, jog_arm released it as a clamp
+                # (jog_arm README, Clamping) and the held key presses no more. Either way the press ends at
+                # about the guard force or below: 19.6-21.6 N by the driver, whose reading differs from the
+                # guard's with the tool strained sideways by friction. Under contact_control's 25 N.
+                guarded = said.code == JogStatus.CONTACT_GUARD and "moving away is allowed" in said.message
+                assert guarded or "clamp released" in said.message, said.message
                 assert held <= GUARD_FORCE + 3.0, held
             # Away from the contact: up 2 cm.
             pressed = z()
