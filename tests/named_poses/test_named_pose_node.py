@@ -257,10 +257,15 @@ def test_a_move_toward_the_face_region_is_slowed_to_the_collaborative_speed_cap(
         msgs = [m for _, m in poses.timed()]
         tips = np.array([[m.pose.position.x, m.pose.position.y, m.pose.position.z] for m in msgs])
         stamps = np.array([m.header.stamp.to_sec() for m in msgs])  # simulated time
-        step = np.linalg.norm(np.diff(tips, axis=0), axis=1) / np.maximum(np.diff(stamps), 1e-6)
-        print(f"\ncap {cap} m/s, tool speed peak {step.max():.3f} m/s; {answer.message}")
+        # Mean speed over 50 ms windows of simulated time: a single pose step's stamp can be off by a
+        # simulation step on a busy machine, which a 2 ms difference turns into a false peak.
+        later = np.searchsorted(stamps, stamps + 0.05)
+        inside = later < len(stamps)
+        first, last = np.flatnonzero(inside), later[inside]
+        speed = np.linalg.norm(tips[last] - tips[first], axis=1) / (stamps[last] - stamps[first])
+        print(f"\ncap {cap} m/s, tool speed peak (50 ms mean) {speed.max():.3f} m/s; {answer.message}")
         # eef_pose is the tool tip, jog_arm's ee_frame_name too; the servos' tracking adds a few percent.
-        assert 0.5 * cap < step.max() <= 1.1 * cap
+        assert 0.5 * cap < speed.max() <= 1.1 * cap
     finally:
         client.update_configuration({"collaborative_region": "hand"})
         poses.close()
