@@ -8,6 +8,7 @@ pytest.importorskip("controller_manager_msgs.srv", reason="needs devel/setup.bas
 
 from controller_manager_msgs import msg, srv
 from driver_emulation_msgs.msg import ErrorRecoveryActionGoal, ErrorRecoveryGoal, ErrorRecoveryResult
+from ur_dashboard_msgs.msg import RobotMode, SafetyMode
 
 # From ros_control's generated code (Noetic, controller_manager_msgs 0.19/0.20) and franka_msgs.
 MD5 = {
@@ -18,6 +19,9 @@ MD5 = {
     # Empty goal and result: the md5 of the empty text, whatever the package's name.
     ErrorRecoveryGoal: "d41d8cd98f00b204e9800998ecf8427e",
     ErrorRecoveryResult: "d41d8cd98f00b204e9800998ecf8427e",
+    # Universal_Robots_ROS_Driver's generated code (ur_dashboard_msgs, Noetic).
+    SafetyMode: "5da08725a63d4237bad689481131a84b",
+    RobotMode: "73b72d58742c4889c47118411b03a3b4",
 }
 
 
@@ -34,3 +38,5 @@ def test_fields_and_constants():
     assert msg.ControllerState.__slots__ == ["name", "state", "type", "claimed_resources"]
     assert ErrorRecoveryActionGoal._type == "driver_emulation_msgs/ErrorRecoveryActionGoal"
     assert ErrorRecoveryActionGoal.__slots__ == ["header", "goal_id", "goal"]
+    assert SafetyMode.PROTECTIVE_STOP == 3 and SafetyMode.NORMAL == 1 and SafetyMode.__slots__ == ["mode"]
+    assert RobotMode.RUNNING == 7 and RobotMode.NO_CONTROLLER == -1 and RobotMode.__slots__ == ["mode"]

@@ -12,6 +12,7 @@ import yaml
 from mujoco_driver.controllers import BEST_EFFORT, STRICT, ControllerManager, ControllerSpec
 from mujoco_driver.emulation import DriverEmulation
 from mujoco_driver.profiles import ProfileError, WrenchSpec, known_profiles, load_profile, option_params
+from mujoco_driver.protective_stop import NORMAL, PROTECTIVE_STOP, ProtectiveStop
 from mujoco_driver.wrench_models import RateDivider, Reflex, WrenchModel, change_frame, gravity_wrench
 
 PROFILE_FOR = {"ur5_custom": "ur_robot_driver", "panda_custom": "franka_ros"}
@@ -157,6 +158,22 @@ def test_zero_makes_the_current_reading_zero():
 def test_rate_divider_keeps_the_average_rate(rate, expected):
     divider = RateDivider(0.002, rate)
     assert sum(divider.due() for _ in range(500)) == pytest.approx(expected, abs=1)
+
+
+def test_protective_stop_trips_on_the_force_magnitude_and_recovers_in_the_drivers_order():
+    stop = ProtectiveStop(150.0, 5.0)
+    assert stop.safety_mode == NORMAL and stop.program_running
+    assert not stop.check(np.array([100.0, -100.0, 0, 9, 9, 9]), 1.0)  # 141 N
+    assert stop.check(np.array([110.0, -110.0, 0, 0, 0, 0]), 2.0)  # 156 N
+    assert stop.safety_mode == PROTECTIVE_STOP and not stop.program_running and "156 N" in stop.reason
+    assert not stop.check(np.full(6, 500.0), 2.1)  # trips once
+    assert not stop.play()[0]
+    ok, answer = stop.unlock(6.9)
+    assert not ok and "5s after occurrence" in answer and stop.safety_mode == PROTECTIVE_STOP
+    assert stop.unlock(7.0)[0] and stop.safety_mode == NORMAL and not stop.program_running
+    assert stop.play()[0] and stop.program_running
+    with pytest.raises(ValueError):
+        ProtectiveStop(0.0, 5.0)
 
 
 def test_reflex_trips_on_any_component_and_holds_until_recovered():

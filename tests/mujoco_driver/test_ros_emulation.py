@@ -105,8 +105,16 @@ def test_the_real_drivers_topics_services_and_action_are_advertised(sim, robot, 
     _driver(sim, robot, graph)
     cm = ["controller_manager/list_controllers", "controller_manager/switch_controller"]
     if robot.package == "ur5_custom":
-        assert sorted(graph.publishers) == ["/tf", "speed_scaling_factor"]
-        assert sorted(graph.services) == [*cm, "ur_hardware_interface/zero_ftsensor"]
+        ur = "ur_hardware_interface/"
+        assert sorted(graph.publishers) == ["/tf", "speed_scaling_factor", ur + "robot_mode",
+                                            ur + "robot_program_running", ur + "safety_mode"]
+        assert sorted(graph.services) == [*cm, ur + "dashboard/play", ur + "dashboard/unlock_protective_stop",
+                                          ur + "resend_robot_program", ur + "zero_ftsensor"]
+        assert [m.mode for m in graph.publishers[ur + "safety_mode"].sent] == [1]  # NORMAL
+        assert [m.mode for m in graph.publishers[ur + "robot_mode"].sent] == [7]  # RUNNING
+        assert [m.data for m in graph.publishers[ur + "robot_program_running"].sent] == [True]
+        assert all(graph.publishers[ur + t].kwargs == {"queue_size": 1, "latch": True}
+                   for t in ("safety_mode", "robot_mode", "robot_program_running"))
         assert not graph.actions
     else:
         assert sorted(graph.publishers) == ["/tf", "~robot_mode"]
@@ -167,6 +175,46 @@ def test_the_state_goes_out_with_its_stamp_and_a_reflex_holds_the_arm_until_reco
     sent = len(mode.sent)
     driver.reset()  # no reflex to recover from: nothing to say
     assert len(mode.sent) == sent
+
+
+def test_a_protective_stop_holds_the_ur_until_unlocked_after_its_wait_and_the_program_restarted(sim, robot,
+                                                                                               graph):
+    if robot.package != "ur5_custom":
+        pytest.skip("ur_robot_driver's protective stop")
+    options = {"protective_stop_force": 30.0, "protective_stop_unlock_after": 0.5}
+    profile = load_profile("ur_robot_driver", options)
+    driver = EmulatedDriver(sim, profile, threading.Lock())
+    driver.advertise(lambda name, cls: rospy.Publisher(name, cls, queue_size=10, tcp_nodelay=True))
+    ur = "ur_hardware_interface/"
+    safety, running = graph.publishers[ur + "safety_mode"], graph.publishers[ur + "robot_program_running"]
+    sim.step(50)
+    assert not driver.update(np.asarray(sim.wrench()))
+    sim.push([0.0, 0.0, -45.0], duration=0.3)
+    for _ in range(30):
+        sim.step(10)
+        if driver.update(np.asarray(sim.wrench())):
+            break
+    else:
+        pytest.fail("a 45 N push did not trip a 30 N protective stop")
+    driver.on_reflex()
+    assert safety.sent[-1].mode == 3 and running.sent[-1].data is False  # PROTECTIVE_STOP, program stopped
+    refusal = driver.refusal("scaled_pos_joint_traj_controller")
+    assert "protective stop: TCP force" in refusal and ur + "dashboard/unlock_protective_stop" in refusal
+    unlock = graph.services[ur + "dashboard/unlock_protective_stop"]
+    play = graph.services[ur + "dashboard/play"]
+    early = play.handler(None)
+    assert not early.success and "protective stop" in early.message
+    sim.step(int(0.1 / sim.dt))
+    answer = unlock.handler(None)  # 0.5 s have not passed yet
+    assert not answer.success and "Cannot unlock protective stop" in answer.message
+    sim.step(int(0.5 / sim.dt))
+    held = sim.qpos.copy()
+    assert unlock.handler(None).success and safety.sent[-1].mode == 1
+    assert "not running" in driver.refusal("scaled_pos_joint_traj_controller")
+    assert graph.services[ur + "resend_robot_program"].handler(None).success and running.sent[-1].data is True
+    assert driver.refusal("scaled_pos_joint_traj_controller") == ""
+    sim.step(int(0.2 / sim.dt))
+    np.testing.assert_allclose(sim.qpos, held, atol=1e-3)  # unlocked and restarted where it was held
 
 
 def test_the_profile_takes_options_from_the_real_drivers_parameters_unless_the_user_set_them(monkeypatch):

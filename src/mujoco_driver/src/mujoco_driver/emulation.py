@@ -13,6 +13,7 @@ import numpy as np
 
 from mujoco_driver.controllers import ControllerManager, SwitchResult
 from mujoco_driver.profiles import DriverProfile, ProfileError
+from mujoco_driver.protective_stop import ProtectiveStop
 from mujoco_driver.sim import Simulation
 from mujoco_driver.wrench_models import Reflex, WrenchModel, change_frame, gravity_wrench, set_payload_weight
 
@@ -42,6 +43,8 @@ class DriverEmulation:
         self.controllers = ControllerManager(profile.controllers, sim.arm_joint_names)
         self.model = WrenchModel(profile.wrench, len(sim.joint_names), 1.0 / profile.publish_rate)
         self.reflex = Reflex(profile.reflex.force_thresholds) if profile.reflex else None
+        stop = profile.protective_stop
+        self.stop = ProtectiveStop(stop.force_limit, stop.unlock_after) if stop else None
         self.wrench = np.zeros(6)  # what the driver publishes [N, Nm]
         spec = profile.wrench
         self._payload_error = spec.payload_mass_error != 0.0 or any(spec.payload_com_error)
@@ -71,7 +74,8 @@ class DriverEmulation:
             sensor: The simulated sensor's reading (``Simulation.wrench``), sensor frame.
 
         Returns:
-            True when this wrench tripped the reflex (the arm is then held where it is).
+            True when this wrench tripped the reflex or the protective stop (the arm is then held where it
+            is).
         """
         sim, data, scene = self.sim, self.sim.data, self.sim.scene
         r_s = data.site_xmat[scene.ft_site].reshape(3, 3)
@@ -91,7 +95,8 @@ class DriverEmulation:
             pos[:] = r_p.T @ (p_c - p_p)
             mujoco.mju_mat2Quat(self._quat, (r_p.T @ r_c).ravel())
             quat[:] = self._quat[1], self._quat[2], self._quat[3], self._quat[0]
-        if self.reflex is not None and self.reflex.check(self.wrench):
+        if (self.reflex is not None and self.reflex.check(self.wrench)) or \
+                (self.stop is not None and self.stop.check(self.wrench, sim.time)):
             sim.set_position_targets(sim.qpos)
             return True
         return False
@@ -102,6 +107,11 @@ class DriverEmulation:
             assert self.profile.reflex is not None  # self.reflex is made from it
             return (f"the robot stopped in a reflex ({self.reflex.reason}): call "
                     f"{self.profile.reflex.recovery_action}")
+        stop, spec = self.stop, self.profile.protective_stop
+        if stop is not None and spec is not None and not stop.program_running:
+            if stop.reason:
+                return f"{stop.reason}: call {spec.unlock_service}, then {spec.play_services[0]}"
+            return f"the robot program is not running: call {spec.play_services[0]}"
         if not self.controllers.accepts(controller):
             state = self.controllers.state(controller)
             return (f"controller {controller} is {state} (running: {self.controllers.running()}); switch it "
@@ -123,6 +133,25 @@ class DriverEmulation:
             return False
         self.sim.set_position_targets(self.sim.qpos)
         return True
+
+    def unlock(self) -> tuple[bool, str]:
+        """The dashboard's unlock_protective_stop: (success, answer); the arm holds where it is."""
+        assert self.stop is not None  # the service exists only with a protective stop
+        self.sim.set_position_targets(self.sim.qpos)
+        return self.stop.unlock(self.sim.time)
+
+    def play(self) -> tuple[bool, str]:
+        """resend_robot_program / dashboard play: (success, answer); the arm holds until a command."""
+        assert self.stop is not None
+        self.sim.set_position_targets(self.sim.qpos)
+        return self.stop.play()
+
+    def reset_stops(self) -> bool:
+        """After the simulation's reset: no reflex, no protective stop; True if there was either."""
+        stopped = self.stop is not None and (bool(self.stop.reason) or not self.stop.program_running)
+        if self.stop is not None:
+            self.stop.reset()
+        return self.recover() or stopped
 
     def zero(self) -> None:
         """Zero the published wrench at its current value (the driver's zero_ftsensor)."""

@@ -31,8 +31,8 @@ from compliant_common.errors import StackError
 
 from mujoco_driver.controllers import ControllerError, ControllerSpec
 
-__all__ = ["DriverProfile", "FrameLink", "ProfileError", "ReflexSpec", "WrenchSpec", "known_profiles",
-           "load_profile", "option_params", "profile_path", "variant_options"]
+__all__ = ["DriverProfile", "FrameLink", "ProfileError", "ProtectiveStopSpec", "ReflexSpec", "WrenchSpec",
+           "known_profiles", "load_profile", "option_params", "profile_path", "variant_options"]
 
 PROFILE_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
                            "config", "profiles")
@@ -129,6 +129,29 @@ class ReflexSpec:
 
 
 @dataclass(frozen=True)
+class ProtectiveStopSpec:
+    """A UR-style protective stop (:mod:`mujoco_driver.protective_stop`) and the driver's names for it.
+
+    Attributes:
+        force_limit: The safety configuration's TCP force limit [N].
+        unlock_after: Seconds after the stop before the dashboard accepts an unlock.
+        safety_mode_topic: ur_dashboard_msgs/SafetyMode topic (latched).
+        robot_mode_topic: ur_dashboard_msgs/RobotMode topic (latched).
+        program_running_topic: std_msgs/Bool topic (latched): the External Control program runs.
+        unlock_service: std_srvs/Trigger service that releases the protective stop.
+        play_services: std_srvs/Trigger services that start the program again.
+    """
+
+    force_limit: float
+    unlock_after: float
+    safety_mode_topic: str
+    robot_mode_topic: str
+    program_running_topic: str
+    unlock_service: str
+    play_services: tuple[str, ...]
+
+
+@dataclass(frozen=True)
 class DriverProfile:
     """A driver's interface, resolved from its YAML and the user's options.
 
@@ -142,6 +165,7 @@ class DriverProfile:
         controllers: The loaded controllers (command topic: ``<name>/command``).
         speed_scaling_topic: std_msgs/Float64 topic of the speed scaling factor ("" = none).
         reflex: See :class:`ReflexSpec` (None = none).
+        protective_stop: See :class:`ProtectiveStopSpec` (None = none).
         options: The resolved options.
     """
 
@@ -154,6 +178,7 @@ class DriverProfile:
     controllers: tuple[ControllerSpec, ...] = ()
     speed_scaling_topic: str = ""
     reflex: ReflexSpec | None = None
+    protective_stop: ProtectiveStopSpec | None = None
     options: Mapping[str, Any] = field(default_factory=dict)
 
     def publish_steps(self, dt: float) -> float:
@@ -309,6 +334,28 @@ def _check_model_errors(wrench: WrenchSpec, where: str) -> None:
                            f"{_FROM_JOINT_TORQUES}, not {wrench.model!r}")
 
 
+def _protective_stop(data: Any, where: str) -> ProtectiveStopSpec | None:
+    if data is None:
+        return None
+    if not isinstance(data, Mapping):
+        raise ProfileError(f"{where}: expected a mapping")
+    unknown = set(data) - set(ProtectiveStopSpec.__dataclass_fields__)
+    if unknown:
+        raise ProfileError(f"{where}: unknown keys {sorted(unknown)}")
+    plays = data.get("play_services")
+    if not (isinstance(plays, list) and plays and all(isinstance(p, str) and p for p in plays)):
+        raise ProfileError(f"{where}.play_services: expected a list of service names, got {plays!r}")
+    return ProtectiveStopSpec(
+        force_limit=_number(data, "force_limit", where, positive=True),
+        unlock_after=_number(data, "unlock_after", where, 0.0),
+        safety_mode_topic=_string(data, "safety_mode_topic", where),
+        robot_mode_topic=_string(data, "robot_mode_topic", where),
+        program_running_topic=_string(data, "program_running_topic", where),
+        unlock_service=_string(data, "unlock_service", where),
+        play_services=tuple(plays),
+    )
+
+
 def load_profile(name_or_path: str, options: Mapping[str, Any] | None = None) -> DriverProfile:
     """Read, resolve and validate a profile.
 
@@ -341,7 +388,7 @@ def load_profile(name_or_path: str, options: Mapping[str, Any] | None = None) ->
     data = _format(data, resolved, where)
 
     known = {"driver", "publish_rate", "joint_states_topic", "wrench", "tf", "controller_manager",
-             "controllers", "speed_scaling_topic", "reflex"}
+             "controllers", "speed_scaling_topic", "reflex", "protective_stop"}
     unknown = set(data) - known
     if unknown:
         raise ProfileError(f"{where}: unknown keys {sorted(unknown)} (known: {sorted(known)})")
@@ -402,6 +449,7 @@ def load_profile(name_or_path: str, options: Mapping[str, Any] | None = None) ->
                                f"[fx fy fz tx ty tz], got {thresholds!r}")
         reflex = ReflexSpec(tuple(float(v) for v in thresholds),
                             _string(r, "recovery_action", f"{where}.reflex"))
+    protective_stop = _protective_stop(data.get("protective_stop"), f"{where}.protective_stop")
     return DriverProfile(
         driver=_string(data, "driver", where),
         publish_rate=_number(data, "publish_rate", where, positive=True),
@@ -412,5 +460,6 @@ def load_profile(name_or_path: str, options: Mapping[str, Any] | None = None) ->
         controllers=controllers,
         speed_scaling_topic=_string(data, "speed_scaling_topic", where, ""),
         reflex=reflex,
+        protective_stop=protective_stop,
         options=resolved,
     )

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 import rospy
 from geometry_msgs.msg import TransformStamped
-from std_msgs.msg import Float64, Float64MultiArray, String
+from std_msgs.msg import Bool, Float64, Float64MultiArray, String
 from std_srvs.srv import Trigger, TriggerResponse
 from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectory
@@ -91,6 +91,7 @@ class EmulatedDriver:
         self._scaling_pub: rospy.Publisher | None = None
         self._mode_pub: rospy.Publisher | None = None  # with a reflex
         self._recovery: Any = None  # actionlib.SimpleActionServer, with a reflex
+        self._safety_pubs: tuple[rospy.Publisher, rospy.Publisher] | None = None  # with a protective stop
         self._services: list[rospy.Service] = []
 
     def subscribe_commands(self, on_trajectory: CommandCallback,
@@ -129,9 +130,32 @@ class EmulatedDriver:
             self._recovery = actionlib.SimpleActionServer(profile.reflex.recovery_action, ErrorRecoveryAction,
                                                           self._on_recovery, auto_start=False)
             self._recovery.start()
+        if profile.protective_stop is not None:
+            self._advertise_protective_stop(profile.protective_stop)
         rospy.loginfo("mujoco_driver: speaking as %s (%s): %.0f Hz, wrench %s in %s (%s), running %s",
                       profile.driver, dict(profile.options), profile.publish_rate, profile.wrench.topic,
                       profile.wrench.frame, profile.wrench.model, self._emu.controllers.running())
+
+    def _advertise_protective_stop(self, spec: Any) -> None:
+        """ur_robot_driver's safety and robot mode, program state and the services that recover."""
+        from ur_dashboard_msgs.msg import RobotMode, SafetyMode
+
+        self._robot_mode_pub = rospy.Publisher(spec.robot_mode_topic, RobotMode, queue_size=1, latch=True)
+        # A protective stop leaves the robot mode as it is (the safety mode changes).
+        self._robot_mode_pub.publish(RobotMode(RobotMode.RUNNING))
+        self._safety_pubs = (rospy.Publisher(spec.safety_mode_topic, SafetyMode, queue_size=1, latch=True),
+                             rospy.Publisher(spec.program_running_topic, Bool, queue_size=1, latch=True))
+        self._services.append(rospy.Service(spec.unlock_service, Trigger, self._on_unlock))
+        self._services += [rospy.Service(name, Trigger, self._on_play) for name in spec.play_services]
+        self._publish_safety()
+
+    def _publish_safety(self) -> None:
+        from ur_dashboard_msgs.msg import SafetyMode
+
+        stop = self._emu.stop
+        assert stop is not None and self._safety_pubs is not None
+        self._safety_pubs[0].publish(SafetyMode(stop.safety_mode))
+        self._safety_pubs[1].publish(Bool(stop.program_running))
 
     # ------------------------------------------------------------- from the loop
     def publish_state(self, stamp: rospy.Time) -> None:
@@ -148,18 +172,27 @@ class EmulatedDriver:
             self._scaling_pub.publish(self._scaling_msg)
 
     def on_reflex(self) -> None:
-        """The reflex tripped at the last :attr:`update` (outside the lock): say so."""
-        reflex, spec = self._emu.reflex, self.profile.reflex  # a reflex tripped: both exist, and ~robot_mode
-        assert reflex is not None and spec is not None and self._mode_pub is not None
-        rospy.logerr("mujoco_driver: %s: the arm stopped; commands are ignored until %s is called",
-                     reflex.reason, spec.recovery_action)
-        self._mode_pub.publish(String("reflex"))
+        """The reflex or the protective stop tripped at the last :attr:`update` (outside the lock): say so."""
+        reflex, spec, stop = self._emu.reflex, self.profile.reflex, self._emu.stop
+        if stop is not None and stop.reason:
+            assert self.profile.protective_stop is not None
+            rospy.logerr("mujoco_driver: %s: the arm stopped; commands are ignored until %s and %s are "
+                         "called", stop.reason, self.profile.protective_stop.unlock_service,
+                         self.profile.protective_stop.play_services[0])
+            self._publish_safety()
+        if reflex is not None and reflex.tripped:
+            assert spec is not None and self._mode_pub is not None
+            rospy.logerr("mujoco_driver: %s: the arm stopped; commands are ignored until %s is called",
+                         reflex.reason, spec.recovery_action)
+            self._mode_pub.publish(String("reflex"))
 
     def reset(self) -> None:
-        """Under the lock, after the simulation's reset: back at the start, so no reflex either."""
-        if self._emu.recover():
-            assert self._mode_pub is not None  # there was a reflex to recover from
-            self._mode_pub.publish(String("move"))
+        """Under the lock, after the simulation's reset: back at the start, so no reflex or stop either."""
+        if self._emu.reset_stops():
+            if self._mode_pub is not None:
+                self._mode_pub.publish(String("move"))
+            if self._safety_pubs is not None:
+                self._publish_safety()
 
     # ------------------------------------------------------ services and action
     def _on_recovery(self, _goal: Any) -> None:
@@ -170,6 +203,22 @@ class EmulatedDriver:
             rospy.loginfo("mujoco_driver: error recovery: the arm takes commands again")
         self._mode_pub.publish(String("move"))
         self._recovery.set_succeeded()
+
+    def _on_unlock(self, _req: Any) -> TriggerResponse:
+        with self._lock:
+            ok, answer = self._emu.unlock()
+        if ok:
+            self._publish_safety()
+        rospy.loginfo("mujoco_driver: unlock_protective_stop: %s", answer)
+        return TriggerResponse(success=ok, message=answer)
+
+    def _on_play(self, _req: Any) -> TriggerResponse:
+        with self._lock:
+            ok, answer = self._emu.play()
+        if ok:
+            self._publish_safety()
+        rospy.loginfo("mujoco_driver: program start: %s", answer)
+        return TriggerResponse(success=ok, message=answer)
 
     def _on_list_controllers(self, _req: Any) -> Any:
         from controller_manager_msgs.msg import ControllerState, HardwareInterfaceResources
