@@ -46,6 +46,8 @@ class FakeContactControl:
             self.services.append(
                 rospy.Service(f"{node}/{name}", Trigger, lambda _req, n=name: self._trigger(n))
             )
+        self.services.append(rospy.Service(f"{ns}/jog_arm_server/recover", Trigger,
+                                           lambda _req: self._trigger("recover")))
         self.guides: list[bool] = []
         self.services.append(rospy.Service(f"{node}/guide", Guide, self._guide))
         self.status = rospy.Publisher(f"{node}/status", ContactControlStatus, queue_size=10)
@@ -88,6 +90,7 @@ def names_in(ns: str) -> RosNames:
         "~contact_control_node": f"{ns}/contact_control_node",
         "~configure_service": f"{ns}/configure_cartesian_impedance",
         "~teach_node": f"{ns}/teach",
+        "~recover_service": f"{ns}/jog_arm_server/recover",
     }
     return RosNames.from_params(lambda key, default: params.get(key, default))
 
@@ -311,12 +314,13 @@ def test_the_window_keeps_running_while_a_call_is_pending(fake, ns, make_widget,
     pump(lambda: widget.answer_label.text().startswith("Applied"), message="the held answer")
 
 
-def test_stop_tare_reset_call_their_services(fake, ns, make_widget, pump):
+def test_stop_tare_reset_recover_call_their_services(fake, ns, make_widget, pump):
     widget = make_widget(ns)
     for button, name in (
         (widget.stop_button, "stop"),
         (widget.tare_button, "tare"),
         (widget.reset_button, "reset"),
+        (widget.recover_button, "recover"),
     ):
         click(button)
         pump(lambda n=name: fake.triggers[-1:] == [n], message=f"the {name} call")
@@ -326,7 +330,7 @@ def test_stop_tare_reset_call_their_services(fake, ns, make_widget, pump):
             ),
             message=f"{name}'s answer",
         )
-    assert fake.triggers == ["stop", "tare", "reset"]
+    assert fake.triggers == ["stop", "tare", "reset", "recover"]
     assert not fake.requests
 
 

@@ -47,6 +47,9 @@ class ContactControlSettings:
     # topics and frames
     ft_in_topic: str = param("wrench", doc="geometry_msgs/WrenchStamped input (original name)")
     velocity_out_topic: str = param("/ee_velocity", doc="geometry_msgs/TwistStamped output (original name)")
+    robot_stop_topic: str = param(
+        "jog_arm_server/robot_stop", doc="std_msgs/String, latched: why the robot stopped by itself ('' "
+        "while it runs; jog_arm README, *Robot stops*): a running move ends with it and requests are refused")
     move_group: str = param("", doc="original: MoveIt group; informational here, the EEF is `eef_frame`")
     fixed_frame: str = param(
         "base_link", doc="world-fixed frame with z up; gravity and travel are measured in it"

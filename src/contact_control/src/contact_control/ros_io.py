@@ -34,6 +34,7 @@ from compliant_control_msgs.srv import (
     GuideResponse,
 )
 from geometry_msgs.msg import TwistStamped, WrenchStamped
+from std_msgs.msg import String
 from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 
 from contact_control.axes import AXES, END_NAMES, EXCEEDED_ACTION_NAMES, LAW_NAMES, SAFETY_NAMES
@@ -137,6 +138,8 @@ class ContactControlRos:
         self._events_pub = rospy.Publisher(private_ns + "events", ContactEvent, queue_size=20, latch=True)
         self._path_sub = rospy.Subscriber(private_ns + "path_reference", PathReference,
                                           self._on_path_reference, queue_size=1, tcp_nodelay=True)
+        self._robot_stop_sub = rospy.Subscriber(s.robot_stop_topic, String, self._on_robot_stop, queue_size=5,
+                                                tcp_nodelay=True)
         self._status_msg = ContactControlStatus(axes=[AxisState(axis=name) for name in AXES])
         self._status_msg.header.frame_id = s.control_frame
         # Service names in the node's namespace (not private), as the original served them.
@@ -334,6 +337,17 @@ class ContactControlRos:
     def master_back(self) -> None:
         with self._lock:
             self._stage.master_back()
+
+    def _on_robot_stop(self, msg: String) -> None:
+        """jog_arm says the robot stopped by itself (or runs again: '')."""
+        with self._lock:
+            if msg.data and msg.data != self._stage.robot_fault:
+                rospy.logerr("contact_control: %s: ending the move; requests are refused until recovered",
+                             msg.data)
+                self.emit_locked(self._stage.robot_stopped(msg.data), rospy.get_time())
+            elif not msg.data and self._stage.robot_fault:
+                self._stage.robot_recovered()
+                rospy.loginfo("contact_control: the robot runs again: requests are taken")
 
     def shutdown(self) -> None:
         """Ends a running move with a zero twist."""

@@ -108,6 +108,7 @@ class ContactStage:
         self._request_note = ""
         self._fault_note = ""  # a clock jump or a lost master, for ~status until it is over
         self.master_fault = ""  # why the ROS master is lost ('' while it answers)
+        self.robot_fault = ""  # why the robot stopped by itself (jog_arm's ~robot_stop), '' while it runs
         self._fault_shown_until = 0.0
         self._cycle_poses: dict[str, list[list[float]]] = {}
         self._last_raw: Sequence[float] = ZERO
@@ -277,6 +278,21 @@ class ContactStage:
     def master_back(self) -> None:
         self._fault_note = self.master_fault = ""
 
+    def robot_stopped(self, reason: str) -> Velocity | None:
+        """The robot stopped by itself: the running move ends with the reason (one zero twist to send) and
+        requests are refused until :meth:`robot_recovered`."""
+        self._fault_note = self.robot_fault = reason
+        return self.stop(reason)
+
+    def robot_recovered(self) -> None:
+        self._fault_note = self.robot_fault = ""
+
+    def _robot_refusal(self) -> Answer | None:
+        if not self.robot_fault:
+            return None
+        return self._refuse(FAILURE, f"refused: {self.robot_fault}; recover it first "
+                                     "(jog_arm_server/recover)")
+
     # --- publish policy ---
     def _emit(self, result: CycleResult, R_command_control: Rows | None = None) -> Velocity | None:
         """The twist to send for a cycle's result, per the publish policy; notes a move's end."""
@@ -327,6 +343,9 @@ class ContactStage:
                 return Answer(True, SUCCESS, "hand-guiding was not on: nothing changed", 0), None
             return Answer(True, SUCCESS, "hand-guiding off: the arm comes to rest", 0), self.stop(
                 "hand-guiding switched off")
+        refused = self._robot_refusal()
+        if refused is not None:
+            return refused, None
         names = tuple(a.strip().lower() for a in axes) or s.guide_axes
         unknown = [a for a in names if a not in AXES]
         if unknown:
@@ -373,6 +392,9 @@ class ContactStage:
     ) -> Answer:
         """Validates and applies a ConfigureForceControl (or, `per_axis`, a ConfigureLaws) request:
         (accepted, code, the laws in words or the reason for refusing)."""
+        refused = self._robot_refusal()
+        if refused is not None:
+            return refused
         validate = validate_laws_request if per_axis else validate_request
         try:
             laws, limited = self.ctrl.bound_gains(validate(req, self.limits))
@@ -408,7 +430,7 @@ class ContactStage:
         r = self.ctrl.last_result
         fault = self._fault_note
         over = r.safety == 0 and self._monotonic() > self._fault_shown_until
-        if fault and over and not fault.startswith("ROS master"):  # the jump is over
+        if fault and over and fault not in (self.master_fault, self.robot_fault):  # the jump is over
             self._fault_note = fault = ""
         return r, "; ".join(m for m in (fault, r.message, self._request_note) if m)
 

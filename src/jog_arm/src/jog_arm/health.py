@@ -1,7 +1,8 @@
 """jog_arm_server's health report for /diagnostics (no ROS): the last cycle's status in levels (the README's
 "Health").
 
-ERROR: no joint state or a stale one, a halt at a singularity or a joint limit (the arm is held). WARN:
+ERROR: no joint state or a stale one, a halt at a singularity or a joint limit (the arm is held), the robot
+stopped by itself (its driver's reason). WARN:
 slowing for a singularity or a joint limit, joint velocities scaled down, the contact guard acting, a clamp
 being released, an invalid command.
 OK: following commands (also at the collaborative speed cap: the values name the cap and the body region),
@@ -22,6 +23,7 @@ LEVELS = {
     StatusCode.STALE_JOINT_STATE: ERROR,
     StatusCode.HALT_FOR_SINGULARITY: ERROR,
     StatusCode.HALT_FOR_JOINT_LIMIT: ERROR,
+    StatusCode.ROBOT_STOPPED: ERROR,
     StatusCode.DECELERATE_FOR_SINGULARITY: WARN,
     StatusCode.DECELERATE_FOR_JOINT_LIMIT: WARN,
     StatusCode.JOINT_VELOCITY_SCALED: WARN,
@@ -34,12 +36,14 @@ _WORDS = {StatusCode.NO_WARNING: "following commands", StatusCode.STALE_COMMAND:
 
 
 def jog_health(name: str, cycle: JogCycle | None, cycles_per_second: float | None, expected: float,
-               master: str, region: str = "off") -> Report:
+               master: str, region: str = "off", robot_stop: str = "") -> Report:
     """The report from the last cycle (None: none yet), the cycles run per second since the last report,
-    and the collaborative speed cap's body region."""
+    the collaborative speed cap's body region and why the robot stopped by itself ("" = it did not)."""
     report = Report(name)
     if master:
         report.check(ERROR, master)
+    if robot_stop:  # also when no cycle runs (publish_on_command with no twist)
+        report.check(ERROR, f"{robot_stop} (recover: the driver's recovery, then ~recover)")
     if cycle is None:
         report.check(ERROR, "no cycle yet (no joint state)")
     else:

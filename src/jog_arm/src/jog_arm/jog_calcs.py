@@ -255,6 +255,15 @@ class JogCalcs:
         """Decelerates to rest and refuses commands until :meth:`unsuspend` (e.g. the master is lost)."""
         self.command.suspend(reason)
 
+    def halt(self, reason: str) -> None:
+        """The robot stopped by itself (its driver holds it): refuses commands like :meth:`suspend`, but with
+        nothing to decelerate: the output is zero at once and the next motion starts from the measured
+        joints, so resuming does not jump to where a deceleration would have taken the arm."""
+        self.command.suspend(reason)
+        self._dq_out = [0.0] * self.nv
+        self._running = self._filter_live = False
+        self._zero_sent = 0
+
     def unsuspend(self) -> None:
         """Accepts commands again; the arm stays at rest until the next one."""
         self.command.unsuspend()

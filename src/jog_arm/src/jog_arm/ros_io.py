@@ -23,6 +23,7 @@ from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from jog_arm.health import jog_health
+from jog_arm.ros_robot_stop import RobotStopRos
 from jog_arm.settings import PARAMETERS, TUNABLE, JogSettings, SettingsError
 from jog_arm.stage import JogCycle, JogStage, log_level
 
@@ -75,6 +76,7 @@ class JogArmRos:
         self._health = DiagnosticsPublisher(self._health_report, s.planning_frame)
         self._prefix = self._health_name.lstrip("/") + "/"
         self._live = LiveParams(PARAMETERS, TUNABLE, PARAMETERS.values_of(s), self._retune, private_ns)
+        self._robot_stop = RobotStopRos(stage, lock, private_ns, self._prefix)
         rospy.loginfo(
             "jog_arm_server: %d joints %s, tip %s, commands on %s (%s) -> %s on %s every %.4f s",
             len(stage.joint_names), stage.joint_names, s.ee_frame_name, rospy.resolve_name(s.cmd_in_topic),
@@ -136,7 +138,7 @@ class JogArmRos:
                 if now < self._throttled.get(kind, 0.0):
                     continue
                 self._throttled[kind] = now + WARN_PERIOD
-            rospy.logwarn("jog_arm_server: %s", text)
+            (rospy.logerr if level == "error" else rospy.logwarn)("jog_arm_server: %s", text)
         stage.notes.clear()
 
     # --- frames ---
@@ -216,13 +218,14 @@ class JogArmRos:
         """jog_arm_server's /diagnostics (its own thread, every 0.1 s; jog_arm.health)."""
         with self._lock:  # only the reads
             cycle, cycles, master = self._stage.last_cycle, self._stage.cycles_run, self._stage.suspended
+            stopped = self._stage.robot_stop
         now = time.monotonic()
         if self._counted is None or now - self._counted[0] >= 0.5:  # a new window
             if self._counted is not None:
                 self._rate = (cycles - self._counted[1]) / (now - self._counted[0])
             self._counted = (now, cycles)
         return jog_health(self._health_name, cycle, self._rate, 1.0 / self._s.pub_period, master,
-                          self._stage.settings.collaborative_region)
+                          self._stage.settings.collaborative_region, stopped)
 
     def master_lost(self, reason: str) -> None:
         rospy.logerr("jog_arm_server: %s: stopping the arm until it returns", reason)
@@ -231,6 +234,7 @@ class JogArmRos:
         """Stops publishing and unregisters the services and publishers."""
         self.closed = True
         self._health.close()
+        self._robot_stop.shutdown()
         for service in self._services:
             service.shutdown()
         self._cmd_pub.unregister()

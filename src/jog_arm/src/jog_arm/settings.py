@@ -50,6 +50,8 @@ _RENAMED = {
 
 # Keys read by the node only (not part of the motion law), accepted without warning.
 _NODE_ONLY = ("robot_description",)
+# Parameter trees read by the node only, each parsed by its own module (robot_stop: jog_arm.robot_stop).
+_NODE_ONLY_TREES = ("robot_stop",)
 
 
 class SettingsError(StackError):
@@ -268,6 +270,8 @@ class JogSettings:
         given: dict[str, object] = {}
         for key in sorted(flat):
             base = key.split("/")[0]
+            if base in _NODE_ONLY_TREES:
+                continue
             if key in PARAMETERS or key in _NODE_ONLY or key.startswith(_NESTED):
                 given[key] = flat[key]
             elif key in _RENAMED or base in _RENAMED:

@@ -118,6 +118,7 @@ class JogStage:
         self._fault_note = ""
         self._fault_shown_until = 0.0
         self.suspended = ""  # why commands are refused (a lost ROS master), '' when they are not
+        self.robot_stop = ""  # why the robot stopped by itself (robot_stop.RobotStop), '' when it did not
         self.notes: list[tuple[str, str]] = []  # (level, text) for the node's log, drained by it
         self.guard: ContactGuard | None = None
         if s.contact_guard_enabled:
@@ -349,6 +350,10 @@ class JogStage:
                 f"clamp: up to {c.peak:.0f} N, over {c.limit_words(self.settings.collaborative_region)} "
                 f"for {c.hold:g} s: backing off along the force at {c.speed:g} m/s until below "
                 f"{c.release:g} N")
+        if self.robot_stop:
+            status, message = StatusCode.ROBOT_STOPPED, (
+                f"{self.robot_stop}; commands are refused until recovered (the driver's recovery, then "
+                "~recover)")
         if self._fault_note:
             if self._monotonic() < self._fault_shown_until:
                 message = f"{self._fault_note}; {message}"
@@ -390,7 +395,23 @@ class JogStage:
 
     def unsuspend(self) -> None:
         self.suspended = ""
-        self.jog.unsuspend()
+        if not self.robot_stop:
+            self.jog.unsuspend()
+
+    def robot_stopped(self, reason: str) -> None:
+        """The robot stopped by itself (its driver says so): hold with no deceleration to command, refuse
+        commands and report ROBOT_STOPPED until :meth:`robot_recovered`."""
+        self.robot_stop = reason
+        self.clamp.active = False
+        self.jog.halt(reason)
+        self.notes.append(("error", f"{reason}: holding; commands are refused until recovered"))
+
+    def robot_recovered(self) -> None:
+        """The driver runs again and recovery was asked for: commands move the arm again, from the measured
+        joints."""
+        self.robot_stop = ""
+        if not self.suspended:
+            self.jog.unsuspend()
 
     @property
     def cycles_run(self) -> int:

@@ -25,6 +25,7 @@ class StatusCode(IntEnum):
     CONTACT_GUARD = 11
     COLLABORATIVE_SPEED_CAP = 12
     CLAMP_RELEASE = 13
+    ROBOT_STOPPED = 14
 
 
 def motion_status(condition: float, s_sing: float, s_pos: float, s_vel: float,

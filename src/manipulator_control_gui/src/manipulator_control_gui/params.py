@@ -41,6 +41,11 @@ class GuiSettings:
     reset_service: str = _derived("`<contact_control_node>/reset`", "Trigger service of Reset")
     guide_service: str = _derived("`<contact_control_node>/guide`", "Guide service of the Guide toggle")
     status_topic: str = _derived("`<contact_control_node>/status`", "status topic of the readout")
+    recover_service: str = param(
+        "jog_arm_server/recover", nonempty=True,
+        doc="jog_arm's Trigger service of Recover: after the robot stopped by itself, the driver's recovery "
+        "and commands taken again (jog_arm README, *Robot stops*)",
+    )
     teach_node: str = param(
         "teach", nonempty=True,
         doc="teach's program_server: the Teach box calls its `~record`, `~stop` and `~replay`",

@@ -33,6 +33,7 @@ class RosNames:
     reset_service: str = f"{_NODE}/reset"
     guide_service: str = f"{_NODE}/guide"
     status_topic: str = f"{_NODE}/status"
+    recover_service: str = GuiSettings.recover_service
     teach_node: str = GuiSettings.teach_node
     #: compliant_control_msgs/ConfigureLaws, used instead of configure_service when registered (it answers
     #: with the reason of a refusal).
@@ -52,6 +53,7 @@ class RosNames:
             reset_service=settings.reset_service or f"{node}/reset",
             guide_service=settings.guide_service or f"{node}/guide",
             status_topic=settings.status_topic or f"{node}/status",
+            recover_service=settings.recover_service,
             teach_node=settings.teach_node,
             laws_service=settings.configure_laws_service or f"{namespace}{slash}{cls.laws_service}",
         )
@@ -209,13 +211,15 @@ class ContactControlClient:
         self._call(self.resolved.laws_service, ConfigureLaws, request, answer, on_done)
 
     def trigger(self, which: str, on_done: Callable[[CallResult], None]) -> None:
-        """Calls the std_srvs/Trigger service `which` ('stop', 'tare' or 'reset') in a worker thread."""
+        """Calls the std_srvs/Trigger service `which` ('stop', 'tare', 'reset' or 'recover') in a worker
+        thread."""
         from std_srvs.srv import Trigger, TriggerRequest
 
         name = {
             "stop": self.resolved.stop_service,
             "tare": self.resolved.tare_service,
             "reset": self.resolved.reset_service,
+            "recover": self.resolved.recover_service,
         }[which]
 
         def answer(response: Any) -> CallResult:

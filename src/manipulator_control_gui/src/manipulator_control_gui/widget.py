@@ -252,6 +252,9 @@ class ControlWidget(QWidget):
         self.tare_button.setToolTip("Zero the force/torque sensor (nothing should touch the tool)")
         self.reset_button = QPushButton("Reset", self)
         self.reset_button.setToolTip("Clear a latched safety stop")
+        self.recover_button = QPushButton("Recover", self)
+        self.recover_button.setToolTip("After the robot stopped by itself (a protective stop, a reflex): run "
+                                       "the driver's recovery and take commands again from where it is held")
         self.guide_button = QPushButton("Guide", self)
         self.guide_button.setCheckable(True)
         self.guide_button.setToolTip("Hand-guiding: the arm follows a push on every axis (the tool's weight "
@@ -261,6 +264,7 @@ class ControlWidget(QWidget):
             (self.stop_button, "stop"),
             (self.tare_button, "tare"),
             (self.reset_button, "reset"),
+            (self.recover_button, "recover"),
             (self.guide_button, "guide"),
         ):
             button.setObjectName(f"{name}_button")
@@ -270,6 +274,7 @@ class ControlWidget(QWidget):
         self.stop_button.clicked.connect(lambda: self._trigger("stop"))
         self.tare_button.clicked.connect(lambda: self._trigger("tare"))
         self.reset_button.clicked.connect(lambda: self._trigger("reset"))
+        self.recover_button.clicked.connect(lambda: self._trigger("recover"))
         self.guide_button.clicked.connect(self._guide)
         layout.addLayout(buttons)
 
