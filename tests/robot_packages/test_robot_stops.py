@@ -17,7 +17,7 @@ pytest.importorskip("ur_dashboard_msgs.msg", reason="needs devel/setup.bash (mak
 from cartesian_impedance_msgs.msg import ControlLaw
 from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceControlRequest
 from compliant_control_msgs.msg import ContactControlStatus, ContactEvent, JogStatus
-from compliant_control_msgs.srv import PushEEF, PushEEFRequest
+from compliant_control_msgs.srv import MoveToNamedPose, PushEEF, PushEEFRequest
 from controller_manager_msgs.srv import SwitchController, SwitchControllerRequest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import PoseStamped, TwistStamped
@@ -65,8 +65,9 @@ def test_a_protective_stop_mid_move_holds_explains_and_resumes_without_a_jump(ro
     args = {"robot_package": "ur5_custom", "profile": "ur_robot_driver", "profile_options": options}
     with run_launch("mujoco_driver", "emulated_robot.launch", args=args) as driver:
         driver.wait_for_topic("/joint_states", timeout=40)
-        with run_launch("ur5_custom", "hardware.launch", args={"with_named_poses": "false"}) as stack:
+        with run_launch("ur5_custom", "hardware.launch") as stack:
             stack.wait_for_service("/configure_cartesian_impedance", timeout=40)
+            stack.wait_for_service("/named_poses/move_to", timeout=40)
             stack.wait_for_service("/jog_arm_server/recover", timeout=40)
             _run(rospy, driver)
             stack.stop()
@@ -120,6 +121,8 @@ def _run(rospy, driver) -> None:
         wait_until(ended, 5, "contact_control's move to end naming the stop")
         wait_until(lambda: not cc.last().move_active, 5, "contact_control's status to show no move")
         assert not configure(law).success
+        moved = rospy.ServiceProxy("/named_poses/move_to", MoveToNamedPose)(name="home", speed_scale=1.0)
+        assert not moved.success and "PROTECTIVE_STOP" in moved.message, moved.message
         # /diagnostics names it within 1 s (simulated time).
         def named() -> bool:
             return any(s.level == DiagnosticStatus.ERROR and "PROTECTIVE_STOP" in s.message
@@ -153,10 +156,41 @@ def _run(rospy, driver) -> None:
         # The 80 N push also latched contact_control's own global force limit: reset it, as a user would.
         assert rospy.ServiceProxy("/contact_control_node/reset", Trigger)().success
         assert configure(law).success, cc.last().message  # contact_control takes requests again
+        assert rospy.ServiceProxy("/contact_control_node/stop", Trigger)().success
+        _named_move_cut_short(rospy, poses, jog, push, recover, stop_topic)
     finally:
         for c in (poses, jog, cc, events, diagnostics, stop_topic):
             c.close()
         pub.unregister()
+
+
+def _named_move_cut_short(rospy, poses, jog, push, recover, stop_topic) -> None:
+    """A named-pose move (a trajectory the driver runs, jog_arm paused) stopped on the way: the service
+    answers at once naming the stop; after recovery the arm is where it was held."""
+    import threading
+
+    wait_until(lambda: jog.last().code != JogStatus.ROBOT_STOPPED, 5, "jog_arm to run")
+    answers: list = []
+    move_to = rospy.ServiceProxy("/named_poses/move_to", MoveToNamedPose)
+    mover = threading.Thread(target=lambda: answers.append(move_to(name="home", speed_scale=0.5)))
+    start = _tip(poses.last())
+    mover.start()
+    wait_until(lambda: np.linalg.norm(_tip(poses.last()) - start) > 0.01, 10, "the named-pose move to start")
+    before = len(jog.msgs)
+    assert push(PushEEFRequest(wrench=_force(-2.0 * LIMIT), duration=0.2)).success
+    mover.join(timeout=10)
+    assert answers and not answers[0].success, answers
+    assert "stopped on the way to 'home'" in answers[0].message and "PROTECTIVE_STOP" in answers[0].message
+    wait_until(lambda: any(m.code == JogStatus.ROBOT_STOPPED for m in jog.msgs[before:]), 5, "ROBOT_STOPPED")
+    t_stop = next(m for m in jog.msgs[before:] if m.code == JogStatus.ROBOT_STOPPED).header.stamp.to_sec()
+    wait_until(lambda: rospy.get_time() > t_stop + UNLOCK_AFTER + 0.1, 10, "the unlock wait")
+    held = _tip(poses.last())
+    answer = recover()
+    assert answer.success, answer.message
+    wait_until(lambda: stop_topic.last().data == "", 5, "~robot_stop cleared")
+    rospy.sleep(0.3)
+    print(f"named move stopped: {answers[0].message}")
+    assert np.linalg.norm(_tip(poses.last()) - held) < 0.002  # recovery moved nothing
 
 
 def _force(x: float):

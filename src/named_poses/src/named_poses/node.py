@@ -31,6 +31,7 @@ from controller_manager_msgs.srv import ListControllers, SwitchController, Switc
 from jog_arm.body_regions import max_speed, region_named
 from jog_arm.kinematics import KinematicsError
 from sensor_msgs.msg import JointState
+from std_msgs.msg import String
 from std_srvs.srv import Trigger
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
@@ -94,6 +95,9 @@ class NamedPoseServer:
                          queue_size=1, tcp_nodelay=True)
         rospy.Subscriber(settings.contact_control_status,
                          ContactControlStatus, self._on_status, queue_size=1)
+        self._robot_stop = ""  # why the robot stopped by itself (jog_arm's ~robot_stop), '' while it runs
+        if self._jog:
+            rospy.Subscriber(f"{self._jog}/robot_stop", String, self._on_robot_stop, queue_size=5)
         self._joints_rx = -1.0  # monotonic time of the last joint state
         self._moving = ""  # the move running ('' when none)
         self._last_answer = "none yet"
@@ -103,6 +107,10 @@ class NamedPoseServer:
         rospy.loginfo(
             "named_pose_server: poses %s for joints %s", sorted(self.poses.poses), list(self.poses.joints)
         )
+
+    def _on_robot_stop(self, msg: String) -> None:
+        with self._lock:
+            self._robot_stop = msg.data
 
     def _on_joints(self, msg: JointState) -> None:
         with self._lock:
@@ -218,6 +226,8 @@ class NamedPoseServer:
         scale = speed_scale or 1.0
         if not 0.0 < scale <= 1.0:
             return self._refuse(f"speed_scale must be in (0, 1], got {speed_scale}")
+        if self._robot_stop:
+            return self._refuse(f"{self._robot_stop}: recover it first ({self._jog}/recover)")
         running = self._contact_move_running()
         if running is None:
             return self._refuse(
@@ -314,6 +324,8 @@ class NamedPoseServer:
         rospy.loginfo("named_pose_server: to %s in %.2f s", name, duration)
         deadline = time.monotonic() + duration + self.settle_time
         while time.monotonic() < deadline and not rospy.is_shutdown():
+            if self._robot_stop:  # the driver holds the arm: the move is over
+                return self._refuse(f"stopped on the way to {name}: {self._robot_stop}")
             now = self._current()
             if now is not None and float(np.max(np.abs(now - goal))) <= self.tolerance:
                 return MoveToNamedPoseResponse(
