@@ -13,6 +13,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 import yaml
+from jog_arm.robot_stop import parse_robot_stop
 from mujoco_driver.profiles import DriverProfile, known_profiles, load_profile
 from robot_setup.driver import GENERIC, DriverError, driver_interface
 from robot_setup.generate import (
@@ -91,6 +92,19 @@ def test_ur_profile_hardware_files_use_its_topics_frames_and_controllers(ur3_pla
     assert (f'switch_controller "{{start_controllers: [{velocity.name}], stop_controllers: '
             f'[{running_trajectory.name}], strictness: 2}}"') in files["README.md"]
     assert "profile:=ur_robot_driver" in header
+    # jog_arm watches the driver's own stops with the profile's names (jog_arm.robot_stop reads them).
+    watches, recover = parse_robot_stop(jog["robot_stop"])
+    stop = profile.protective_stop
+    assert [w.topic for w in watches] == [stop.safety_mode_topic, stop.program_running_topic]
+    assert recover == (stop.unlock_service, stop.play_services[0])
+    assert "<exec_depend>ur_dashboard_msgs</exec_depend>" in files["package.xml"]
+
+
+def test_a_profile_without_a_protective_stop_watches_nothing(ur3_plan):
+    for driver in ("franka_ros", ""):
+        files = render(_with_driver(ur3_plan, driver))
+        assert "robot_stop" not in yaml.safe_load(files["config/jog_arm_hardware.yaml"])
+        assert "ur_dashboard_msgs" not in files["package.xml"]
 
 
 def test_the_driver_changes_only_the_hardware_files_readme_and_package_xml(ur3_plan):

@@ -32,7 +32,14 @@ from collections.abc import Collection
 from dataclasses import dataclass
 
 from compliant_common.errors import StackError
-from mujoco_driver.profiles import DriverProfile, ProfileError, known_profiles, load_profile, profile_path
+from mujoco_driver.profiles import (
+    DriverProfile,
+    ProfileError,
+    ProtectiveStopSpec,
+    known_profiles,
+    load_profile,
+    profile_path,
+)
 
 __all__ = ["GENERIC", "GENERIC_TRAJECTORY_TOPIC", "DriverError", "DriverInterface", "driver_interface"]
 
@@ -69,6 +76,7 @@ class DriverInterface:
         stop_for_jog: Controllers to stop when switching jog_controller on.
         trajectory_controller: The controller named_poses sends trajectories to ("" = generic).
         trajectory_initial_state: Its state at the driver's start.
+        protective_stop: The driver's safety stop and recovery (None = none; jog_arm's `robot_stop`).
     """
 
     profile: str = ""
@@ -89,6 +97,7 @@ class DriverInterface:
     stop_for_jog: tuple[str, ...] = ()
     trajectory_controller: str = ""
     trajectory_initial_state: str = "running"
+    protective_stop: ProtectiveStopSpec | None = None
 
     @property
     def generic(self) -> bool:
@@ -213,6 +222,7 @@ def driver_interface(driver: str) -> DriverInterface:
         jog_command=command,
         jog_initial_state=jog_state,
         stop_for_jog=stop if jog_state != "running" else (),
+        protective_stop=profile.protective_stop,
         trajectory_controller=trajectory,
         trajectory_initial_state=trajectory_state,
     )

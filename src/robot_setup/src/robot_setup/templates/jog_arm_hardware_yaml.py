@@ -37,6 +37,24 @@ low_pass_filter_coeff: 2.5
 {thresholds(plan)}{chain(plan)}"""
 
 
+def _robot_stop(d: DriverInterface) -> str:
+    """jog_arm's watch of the driver's own stops (its README's *Robot stops*), for a profile that has one."""
+    stop = d.protective_stop
+    if stop is None:
+        return ""
+    return f"""
+# The robot's own stops (jog_arm README, "Robot stops"): {d.driver}'s safety mode and program state.
+robot_stop:
+  watch:
+    - {{topic: {stop.safety_mode_topic}, type: ur_dashboard_msgs/SafetyMode, field: mode,
+       running: [1, 2]}}                    # NORMAL, REDUCED
+    - {{topic: {stop.program_running_topic}, type: std_msgs/Bool, field: data, running: [true]}}
+  recover:                                 # std_srvs/Trigger, called in this order
+    - {stop.unlock_service}
+    - {stop.play_services[0]}
+"""
+
+
 def _pub_period(d: DriverInterface) -> str:
     """jog_arm's cycle for a driver: its filter acts per cycle, so for a velocity controller (which takes the
     newest command each of its periods) a short cycle keeps the lag small; trajectories stay at 8 ms."""
@@ -76,5 +94,4 @@ simu: false
 incoming_cmd_timeout: 0.1
 joint_state_timeout: {d.state_timeout:g}              # [s] {num(d.state_timeout * d.rate)} periods of the driver's joint states (at least 0.1 s)
 low_pass_filter_coeff: 2.5
-{thresholds(plan)}{chain(plan)}"""
-
+{thresholds(plan)}{chain(plan)}{_robot_stop(d)}"""

@@ -8,6 +8,11 @@ from robot_setup.templates.text import generated_by
 __all__ = ["package_xml"]
 
 
+def _stop_messages(plan: Plan) -> str:
+    """The message package of the driver's safety mode that jog_arm watches (jog_arm_hardware.yaml)."""
+    return "\n  <exec_depend>ur_dashboard_msgs</exec_depend>" if plan.driver.protective_stop else ""
+
+
 def package_xml(plan: Plan) -> str:
     name = plan.spec.name
     return f"""<?xml version="1.0"?>
@@ -30,7 +35,7 @@ def package_xml(plan: Plan) -> str:
   <exec_depend>keyboard_publisher</exec_depend>
   <exec_depend>mujoco_driver</exec_depend>
   <exec_depend>named_poses</exec_depend>
-  <exec_depend>robot_state_publisher</exec_depend>
+  <exec_depend>robot_state_publisher</exec_depend>{_stop_messages(plan)}
   <!-- The URDF and meshes stay where they are ({plan.source}); nothing is copied here. -->
 </package>
 """
