@@ -205,19 +205,18 @@ class EmulatedDriver:
         self._recovery.set_succeeded()
 
     def _on_unlock(self, _req: Any) -> TriggerResponse:
-        with self._lock:
-            ok, answer = self._emu.unlock()
-        if ok:
-            self._publish_safety()
-        rospy.loginfo("mujoco_driver: unlock_protective_stop: %s", answer)
-        return TriggerResponse(success=ok, message=answer)
+        return self._recovery_step(self._emu.unlock, "unlock_protective_stop")
 
     def _on_play(self, _req: Any) -> TriggerResponse:
+        return self._recovery_step(self._emu.play, "program start")
+
+    def _recovery_step(self, step: Callable[[], tuple[bool, str]], what: str) -> TriggerResponse:
+        """One dashboard step of the protective stop's recovery: its answer, the new state published."""
         with self._lock:
-            ok, answer = self._emu.play()
+            ok, answer = step()
         if ok:
             self._publish_safety()
-        rospy.loginfo("mujoco_driver: program start: %s", answer)
+        rospy.loginfo("mujoco_driver: %s: %s", what, answer)
         return TriggerResponse(success=ok, message=answer)
 
     def _on_list_controllers(self, _req: Any) -> Any:
