@@ -90,6 +90,8 @@ class TaskLoop:
         self.commands: list[Command] = []
         self._touched = False
         self._was_touching = False
+        #: From this time on the robot is stopped by its driver (held; jog_arm's ~robot_stop says `stop_why`).
+        self.stop_at, self.stop_why = math.inf, "the robot stopped: a protective stop"
 
     def _apply(self, command: Command) -> None:
         self.commands.append(command)
@@ -113,7 +115,8 @@ class TaskLoop:
             touching = math.sqrt(sum(f * f for f in result.wrench[:3])) >= 3.0
             self._touched |= touching and not self._was_touching
             self._was_touching = touching
-            self.pose[:3, 3] += np.asarray(result.velocity[:3]) * DT
+            if self.t < self.stop_at:  # held by the driver after it
+                self.pose[:3, 3] += np.asarray(result.velocity[:3]) * DT
             self.t += DT
             wrench = self.world.wrench(self.pose)
             self.trace.append((self.t, *self.pose[:3, 3], wrench[2]))
@@ -125,7 +128,9 @@ class TaskLoop:
 
     def _observe(self, wrench: object, active: bool) -> Observation:
         touched, self._touched = self._touched, False
-        return Observation(self.t, self.pose.copy(), tuple(wrench), active, "", touched)  # type: ignore[arg-type]
+        stop = self.stop_why if self.t >= self.stop_at else ""
+        return Observation(self.t, self.pose.copy(), tuple(wrench), active, "", touched,  # type: ignore[arg-type]
+                           robot_stop=stop)
 
 
 def tool_down(x: float, y: float, z: float) -> np.ndarray:

@@ -44,6 +44,18 @@ def test_a_hole_too_far_away_fails_the_search_with_its_reason_and_retracts():
     assert loop.run.result.peak_force < 30.0
 
 
+def test_a_robot_stop_ends_the_task_at_once_with_its_reason_and_nothing_more_is_tried():
+    """The driver holds the arm (jog_arm's ~robot_stop): no step can move it, not even the retract."""
+    loop = TaskLoop(TaskRun(load_task_file(PEG_IN_HOLE)), HoleWorld(hole=(0.015, 0.0)), START)
+    loop.stop_at = 4.0  # searching by then: the hole is out of reach
+    end = loop.go(60.0)
+    assert end.outcome == FAILED and end.stop
+    step = loop.commands[-2].step
+    assert end.reason == f"in step '{step}': the robot stopped: a protective stop"
+    assert "retract" not in loop.run.result.step_times
+    assert loop.t < 4.1  # at the first observation after the stop
+
+
 def test_the_force_ceiling_fails_the_task_at_once_and_the_retract_runs():
     """A compliant move down would press b V = 20 N: the task's 6 N ceiling fails it and backs off."""
     hard = parse_task({

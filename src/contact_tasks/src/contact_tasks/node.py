@@ -35,6 +35,7 @@ from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsRequest
 from contact_control.frames import matrix_quaternion, quaternion_matrix
 from dynamic_reconfigure.client import Client
 from geometry_msgs.msg import Point, Pose, Quaternion
+from std_msgs.msg import String
 from std_srvs.srv import Trigger
 
 from contact_tasks.params import TaskServerSettings, load_settings
@@ -64,6 +65,7 @@ class TaskServer:
         self._lock = threading.Lock()
         self._status: ContactControlStatus | None = None
         self._touched = self._released = False
+        self._robot_stop = ""  # jog_arm's ~robot_stop while a task runs
         self._not_before = math.inf  # events from before the task are ignored
         self._laws_at = math.inf
         self._subs: list[rospy.Subscriber] = []
@@ -92,6 +94,7 @@ class TaskServer:
         self._subs = [
             rospy.Subscriber(self._cc + "/status", ContactControlStatus, self._on_status, queue_size=1),
             rospy.Subscriber(self._cc + "/events", ContactEvent, self._on_event, queue_size=50),
+            rospy.Subscriber(self.s.jog_arm + "/robot_stop", String, self._on_robot_stop, queue_size=5),
         ]
 
     def _unlisten(self) -> None:
@@ -99,7 +102,7 @@ class TaskServer:
             sub.unregister()
         self._subs = []
         with self._lock:
-            self._status = None
+            self._status, self._robot_stop = None, ""
 
     def _wait_for_inputs(self) -> tuple[ContactControlStatus | None, FloatArray | None]:
         """The first status and tool pose, waiting up to `status_timeout` (the time's own clock)."""
@@ -117,6 +120,10 @@ class TaskServer:
     def _on_status(self, msg: ContactControlStatus) -> None:
         with self._lock:
             self._status = msg
+
+    def _on_robot_stop(self, msg: String) -> None:
+        with self._lock:
+            self._robot_stop = msg.data
 
     def _on_event(self, msg: ContactEvent) -> None:
         with self._lock:
@@ -137,7 +144,7 @@ class TaskServer:
 
     def _observe(self, tool: FloatArray) -> Observation:
         with self._lock:
-            status = self._status
+            status, robot_stop = self._status, self._robot_stop
             touched, released = self._touched, self._released
             self._touched = self._released = False
         wrench: tuple[float, ...] = (0.0,) * 6
@@ -147,7 +154,7 @@ class TaskServer:
             wrench = (f.x, f.y, f.z, t.x, t.y, t.z)
             if status.header.stamp.to_sec() >= self._laws_at:  # it knows the step's laws
                 active, message = status.move_active, status.message
-        return Observation(rospy.get_time(), tool, wrench, active, message, touched, released)
+        return Observation(rospy.get_time(), tool, wrench, active, message, touched, released, robot_stop)
 
     # outputs
 

@@ -39,6 +39,7 @@ class Observation:
             came).
         move_message: contact_control's status message (why the move ended).
         touched, released: a touch / release event came since the previous observation.
+        robot_stop: why the robot stopped by itself (jog_arm's ``~robot_stop``), "" while it runs.
     """
 
     t: float
@@ -48,6 +49,7 @@ class Observation:
     move_message: str = ""
     touched: bool = False
     released: bool = False
+    robot_stop: str = ""
 
 
 Position = tuple[float, float, float]
@@ -136,6 +138,9 @@ class TaskRun:
         """One cycle: the task's ceilings, then the step's exits in order; the reference to stream."""
         if not self.running or self._step is None:
             return Command(self.step_name, outcome=self.result.outcome, reason=self.result.reason)
+        if obs.robot_stop:  # the driver holds the arm: no step, not even the retract, can move it
+            failing = f"{self._failing}; then " if self._failing else ""
+            return self._end(FAILED, f"{failing}in step '{self.step_name}': {obs.robot_stop}", obs)
         force = math.sqrt(sum(f * f for f in obs.wrench[:3]))
         torque = math.sqrt(sum(f * f for f in obs.wrench[3:]))
         self.result.peak_force = max(self.result.peak_force, force)
