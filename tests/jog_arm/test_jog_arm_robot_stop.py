@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from jog_arm.robot_stop import RobotStop, StopWatch, parse_robot_stop
+from jog_arm.robot_stop import RecoveryStep, RobotStop, StopWatch, parse_robot_stop
 from jog_arm.settings import JogSettings, SettingsError
 from jog_arm.stage import JogStage
 from jog_arm.status import StatusCode
@@ -26,13 +26,21 @@ def test_the_parameter_names_topics_and_recovery_services_and_bad_ones_are_refus
     watches, services = parse_robot_stop(UR, "/jog_arm_server/")
     assert [w.topic for w in watches] == ["ur_hardware_interface/safety_mode",
                                           "ur_hardware_interface/robot_program_running"]
-    assert watches[0].running == (1, 2) and services == tuple(UR["recover"])
+    assert watches[0].running == (1, 2) and services == tuple(RecoveryStep(name) for name in UR["recover"])
     assert parse_robot_stop({}) == ((), ())
+    franka = {"watch": [{"topic": "franka_state_controller/franka_states", "type": "franka_msgs/FrankaState",
+                         "field": "robot_mode", "running": [1, 2]}],
+              "recover": [{"action": "franka_control/error_recovery",
+                           "type": "franka_msgs/ErrorRecoveryAction"}]}
+    assert parse_robot_stop(franka)[1] == (RecoveryStep("franka_control/error_recovery",
+                                                        "franka_msgs/ErrorRecoveryAction"),)
     bad = [({"watch": [{"topic": "t", "type": "p/M", "field": "f"}]}, r"watch\[0\]"),
            ({"watch": [{"topic": "t", "type": "M", "field": "f", "running": [1]}]}, "package/Message"),
            ({"watch": [{"topic": "t", "type": "p/M", "field": "f", "running": []}]}, r"watch\[0\]\.running"),
            ({"recover": ["s"]}, "needs watch entries"),
            ({"watch": [], "recover": "s"}, r"robot_stop\.recover"),
+           ({"watch": UR["watch"], "recover": [{"action": "a", "type": "p/Goal"}]}, r"recover\[0\]: "),
+           ({"watch": UR["watch"], "recover": [3]}, r"recover\[0\]"),
            ({"other": 1}, "keys watch and recover")]
     for params, message in bad:
         with pytest.raises(SettingsError, match=message):

@@ -1,13 +1,13 @@
-"""controller_manager_msgs (the subset the emulated drivers serve) and driver_emulation_msgs keep the real
-packages' wire format: genmsg computes an md5sum from the definition text, so identical fields and constants
-give the md5sums that ros_control's (Noetic) and franka_msgs' generated code carry."""
+"""controller_manager_msgs, franka_msgs and ur_dashboard_msgs (the subsets the emulated drivers serve) keep
+the real packages' wire format: genmsg computes an md5sum from the definition text, so identical fields and
+constants give the md5sums that the upstream packages' generated code carries."""
 
 import pytest
 
 pytest.importorskip("controller_manager_msgs.srv", reason="needs devel/setup.bash (make test sources it)")
 
 from controller_manager_msgs import msg, srv
-from driver_emulation_msgs.msg import ErrorRecoveryActionGoal, ErrorRecoveryGoal, ErrorRecoveryResult
+from franka_msgs.msg import ErrorRecoveryActionGoal, ErrorRecoveryGoal, ErrorRecoveryResult, FrankaState
 from ur_dashboard_msgs.msg import RobotMode, SafetyMode
 
 # From ros_control's generated code (Noetic, controller_manager_msgs 0.19/0.20) and franka_msgs.
@@ -16,9 +16,11 @@ MD5 = {
     srv.SwitchController: "b29a7abc673b2c54c14b54e50f8d06a5",
     msg.ControllerState: "aeb6b261d97793ab74099a3740245272",
     msg.HardwareInterfaceResources: "f25b55cbf1d1f76e82e5ec9e83f76258",
-    # Empty goal and result: the md5 of the empty text, whatever the package's name.
+    # Empty goal and result: the md5 of the empty text.
     ErrorRecoveryGoal: "d41d8cd98f00b204e9800998ecf8427e",
     ErrorRecoveryResult: "d41d8cd98f00b204e9800998ecf8427e",
+    # franka_ros 0.10's generated code (franka_msgs/FrankaState.h of rosserial builds): it covers Errors too.
+    FrankaState: "431567d5df6caf4e4dd7385f25cb71ee",
     # Universal_Robots_ROS_Driver's generated code (ur_dashboard_msgs, Noetic).
     SafetyMode: "5da08725a63d4237bad689481131a84b",
     RobotMode: "73b72d58742c4889c47118411b03a3b4",
@@ -36,7 +38,9 @@ def test_fields_and_constants():
         "start_controllers", "stop_controllers", "strictness", "start_asap", "timeout"]
     assert srv.ListControllersResponse.__slots__ == ["controller"]
     assert msg.ControllerState.__slots__ == ["name", "state", "type", "claimed_resources"]
-    assert ErrorRecoveryActionGoal._type == "driver_emulation_msgs/ErrorRecoveryActionGoal"
+    assert ErrorRecoveryActionGoal._type == "franka_msgs/ErrorRecoveryActionGoal"
+    assert FrankaState.ROBOT_MODE_MOVE == 2 and FrankaState.ROBOT_MODE_REFLEX == 4
+    assert len(FrankaState().q) == 7 and FrankaState().current_errors.cartesian_reflex is False
     assert ErrorRecoveryActionGoal.__slots__ == ["header", "goal_id", "goal"]
     assert SafetyMode.PROTECTIVE_STOP == 3 and SafetyMode.NORMAL == 1 and SafetyMode.__slots__ == ["mode"]
     assert RobotMode.RUNNING == 7 and RobotMode.NO_CONTROLLER == -1 and RobotMode.__slots__ == ["mode"]

@@ -17,6 +17,7 @@ pytest.importorskip("controller_manager_msgs.srv", reason="needs devel/setup.bas
 
 import actionlib
 import rospy
+from franka_msgs.msg import FrankaState
 from mujoco_driver.controllers import STRICT
 from mujoco_driver.params import DriverSettings
 from mujoco_driver.profiles import load_profile
@@ -117,10 +118,11 @@ def test_the_real_drivers_topics_services_and_action_are_advertised(sim, robot, 
                    for t in ("safety_mode", "robot_mode", "robot_program_running"))
         assert not graph.actions
     else:
-        assert sorted(graph.publishers) == ["/tf", "~robot_mode"]
+        assert sorted(graph.publishers) == ["/tf", "franka_state_controller/franka_states"]
         assert sorted(graph.services) == cm
-        mode = graph.publishers["~robot_mode"]
-        assert mode.kwargs == {"queue_size": 1, "latch": True} and [m.data for m in mode.sent] == ["move"]
+        state = graph.publishers["franka_state_controller/franka_states"]
+        assert state.data_class is FrankaState and state.kwargs == {"queue_size": 10, "tcp_nodelay": True}
+        assert not state.sent  # with each joint state
         assert graph.actions["franka_control/error_recovery"].started
 
 
@@ -158,6 +160,11 @@ def test_the_state_goes_out_with_its_stamp_and_a_reflex_holds_the_arm_until_reco
         assert [m.data for m in graph.publishers["speed_scaling_factor"].sent] == [1.0]
         return
     assert [t.child_frame_id for t in tf.transforms] == ["panda_NE", "panda_EE", "panda_K"]
+    states = graph.publishers["franka_state_controller/franka_states"].sent
+    [state] = states
+    assert state.header.stamp == stamp and state.robot_mode == FrankaState.ROBOT_MODE_MOVE
+    np.testing.assert_allclose(state.q, sim.qpos, atol=1e-12)
+    np.testing.assert_allclose(state.K_F_ext_hat_K, driver.wrench)
     sim.push([0.0, 0.0, -40.0], duration=0.3)
     tripped = False
     for _ in range(50):
@@ -165,16 +172,17 @@ def test_the_state_goes_out_with_its_stamp_and_a_reflex_holds_the_arm_until_reco
         tripped = driver.update(np.asarray(sim.wrench())) or tripped
     assert tripped
     driver.on_reflex()
-    mode = graph.publishers["~robot_mode"]
-    assert mode.sent[-1].data == "reflex"
+    driver.publish_state(rospy.Time(4))
+    assert states[-1].robot_mode == FrankaState.ROBOT_MODE_REFLEX
+    assert states[-1].current_errors.cartesian_reflex
     assert "franka_control/error_recovery" in driver.refusal("position_joint_trajectory_controller")
     action = graph.actions["franka_control/error_recovery"]
     action.execute(None)
-    assert action.succeeded == 1 and mode.sent[-1].data == "move"
-    assert driver.refusal("position_joint_trajectory_controller") == ""
-    sent = len(mode.sent)
-    driver.reset()  # no reflex to recover from: nothing to say
-    assert len(mode.sent) == sent
+    assert action.succeeded == 1 and driver.refusal("position_joint_trajectory_controller") == ""
+    driver.publish_state(rospy.Time(5))
+    assert states[-1].robot_mode == FrankaState.ROBOT_MODE_MOVE
+    assert not states[-1].current_errors.cartesian_reflex
+    assert states[-1].last_motion_errors.cartesian_reflex  # what stopped the last motion
 
 
 def test_a_protective_stop_holds_the_ur_until_unlocked_after_its_wait_and_the_program_restarted(sim, robot,

@@ -34,14 +34,14 @@ from cartesian_impedance_msgs.srv import ConfigureForceControl, ConfigureForceCo
 from compliant_control_msgs.msg import ContactControlStatus
 from compliant_control_msgs.srv import MoveToNamedPose, PushEEF, PushEEFRequest
 from controller_manager_msgs.srv import ListControllers, SwitchController, SwitchControllerRequest
-from driver_emulation_msgs.msg import ErrorRecoveryAction, ErrorRecoveryGoal
+from franka_msgs.msg import ErrorRecoveryAction, ErrorRecoveryGoal, FrankaState
 from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
 from harness.launch import run_launch
 from harness.waiting import Collector, wait_until
 from mujoco_driver.profiles import DriverProfile, load_profile
 from robot_setup.generate import recorded_command
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64, String
+from std_msgs.msg import Float64
 from std_srvs.srv import Trigger
 
 # What a user on the real cell has: the driver's names (from the real drivers' documentation).
@@ -254,13 +254,15 @@ def test_hardware_launch_runs_unchanged_against_the_emulated_driver(ros_node, ro
         if profile.reflex is not None and not hardware_args:  # the driver's reflex, whatever the interface
             # Over the collision threshold (franka's 20 N): the reflex stops the arm until error recovery.
             pose, _cc_status, twist_pub = clients
-            mode = Collector("/mujoco_driver/robot_mode", String)
+            mode = Collector(f"/{profile.reflex.state.topic}", FrankaState)
             mode.wait_for(1, timeout=5)
-            assert mode.last().data == "move"
+            assert mode.last().robot_mode == FrankaState.ROBOT_MODE_MOVE
             push = PushEEFRequest(duration=0.3)
             push.wrench.force.z = -1.5 * profile.reflex.force_thresholds[2]
             assert rospy.ServiceProxy("/mujoco_driver/push", PushEEF)(push).success
-            wait_until(lambda: mode.last().data == "reflex", 10, "the reflex to trip")
+            reflex = lambda: mode.last().robot_mode == FrankaState.ROBOT_MODE_REFLEX  # noqa: E731
+            wait_until(reflex, 10, "the reflex to trip")
+            assert mode.last().current_errors.cartesian_reflex
             _settle(rospy, cell["joints"])
             held = _jog(rospy, twist_pub, pose, cell["base"], messages=50, proc=driver.proc)
             assert np.linalg.norm(held) < 2e-3, f"the arm moved in reflex mode: {held}"
@@ -268,10 +270,16 @@ def test_hardware_launch_runs_unchanged_against_the_emulated_driver(ros_node, ro
             assert recovery.wait_for_server(rospy.Duration(10))
             recovery.send_goal(ErrorRecoveryGoal())
             assert recovery.wait_for_result(rospy.Duration(10))
-            wait_until(lambda: mode.last().data == "move", 5, "the robot mode back to move")
+            move = lambda: mode.last().robot_mode == FrankaState.ROBOT_MODE_MOVE  # noqa: E731
+            wait_until(move, 5, "the robot mode back to move")
+            # The driver runs again, but jog_arm (robot_stop) holds until asked: jogs still move nothing.
+            held = _jog(rospy, twist_pub, pose, cell["base"], messages=25, proc=driver.proc)
+            assert np.linalg.norm(held) < 1e-3, f"jog_arm moved the arm before ~recover: {held}"
+            answer = rospy.ServiceProxy("/jog_arm_server/recover", Trigger)()
+            assert answer.success, answer.message
             _jog(rospy, twist_pub, pose, cell["base"], distance=0.01, proc=driver.proc)
-            print(f"{robot}: a {-push.wrench.force.z:g} N push tripped the reflex; after error recovery the "
-                  "arm jogged again")
+            print(f"{robot}: a {-push.wrench.force.z:g} N push tripped the reflex; after error recovery and "
+                  "jog_arm's ~recover the arm jogged again")
             mode.close()
 
 

@@ -96,15 +96,23 @@ def test_ur_profile_hardware_files_use_its_topics_frames_and_controllers(ur3_pla
     watches, recover = parse_robot_stop(jog["robot_stop"])
     stop = profile.protective_stop
     assert [w.topic for w in watches] == [stop.safety_mode_topic, stop.program_running_topic]
-    assert recover == (stop.unlock_service, stop.play_services[0])
+    assert [step.name for step in recover] == [stop.unlock_service, stop.play_services[0]]
     assert "<exec_depend>ur_dashboard_msgs</exec_depend>" in files["package.xml"]
 
 
-def test_a_profile_without_a_protective_stop_watches_nothing(ur3_plan):
-    for driver in ("franka_ros", ""):
-        files = render(_with_driver(ur3_plan, driver))
-        assert "robot_stop" not in yaml.safe_load(files["config/jog_arm_hardware.yaml"])
-        assert "ur_dashboard_msgs" not in files["package.xml"]
+def test_a_franka_profile_watches_its_robot_mode_and_the_generic_driver_nothing(ur3_plan):
+    profile = load_profile("franka_ros")
+    files = render(_with_driver(ur3_plan, "franka_ros"))
+    watches, recover = parse_robot_stop(yaml.safe_load(files["config/jog_arm_hardware.yaml"])["robot_stop"])
+    state = profile.reflex.state
+    assert [(w.topic, w.type, w.field, w.running) for w in watches] == [
+        (state.topic, "franka_msgs/FrankaState", "robot_mode", (1, 2))]
+    assert [(s.name, s.action_type) for s in recover] == [
+        (profile.reflex.recovery_action, "franka_msgs/ErrorRecoveryAction")]
+    assert "<exec_depend>franka_msgs</exec_depend>" in files["package.xml"]
+    generic = render(_with_driver(ur3_plan, ""))
+    assert "robot_stop" not in yaml.safe_load(generic["config/jog_arm_hardware.yaml"])
+    assert "_msgs</exec_depend>" not in generic["package.xml"]
 
 
 def test_the_driver_changes_only_the_hardware_files_readme_and_package_xml(ur3_plan):

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from jog_arm.settings import SettingsError
 
-__all__ = ["RobotStop", "StopWatch", "parse_robot_stop"]
+__all__ = ["RecoveryStep", "RobotStop", "StopWatch", "parse_robot_stop"]
 
 
 @dataclass(frozen=True)
@@ -27,9 +27,20 @@ class StopWatch:
     running: tuple[object, ...]
 
 
-def parse_robot_stop(params: object, prefix: str = "") -> tuple[tuple[StopWatch, ...], tuple[str, ...]]:
-    """The watched topics and the recovery services (std_srvs/Trigger, called in order) from the
-    ``robot_stop`` parameter ({} or None: nothing watched).
+@dataclass(frozen=True)
+class RecoveryStep:
+    """One step of the driver's recovery: a std_srvs/Trigger service, or an action with an empty goal
+    (``action_type``: its ``package/NameAction``)."""
+
+    name: str
+    action_type: str = ""  # "": a std_srvs/Trigger service
+
+
+def parse_robot_stop(params: object, prefix: str = "") -> tuple[tuple[StopWatch, ...],
+                                                               tuple[RecoveryStep, ...]]:
+    """The watched topics and the recovery steps (called in order) from the ``robot_stop`` parameter ({} or
+    None: nothing watched). A step is a service name (std_srvs/Trigger) or ``{action: name, type:
+    package/NameAction}`` (an action whose goal is empty).
 
     Raises:
         SettingsError: Naming the bad key.
@@ -52,12 +63,23 @@ def parse_robot_stop(params: object, prefix: str = "") -> tuple[tuple[StopWatch,
             raise SettingsError(f"{at}.running: expected a non-empty list of values, got {running!r}")
         watches.append(StopWatch(entry["topic"], entry["type"], entry["field"], tuple(running)))
     recover = params.get("recover") or []
-    if not isinstance(recover, list) or not all(isinstance(s, str) and s for s in recover):
-        raise SettingsError(f"{where}.recover: expected a list of std_srvs/Trigger service names, "
-                            f"got {recover!r}")
-    if recover and not watches:
+    if not isinstance(recover, list):
+        raise SettingsError(f"{where}.recover: expected a list of steps, got {recover!r}")
+    steps = [_recovery_step(entry, f"{where}.recover[{i}]") for i, entry in enumerate(recover)]
+    if steps and not watches:
         raise SettingsError(f"{where}.recover: needs watch entries (nothing would say the robot stopped)")
-    return tuple(watches), tuple(recover)
+    return tuple(watches), tuple(steps)
+
+
+def _recovery_step(entry: object, where: str) -> RecoveryStep:
+    if isinstance(entry, str) and entry:
+        return RecoveryStep(entry)
+    if isinstance(entry, Mapping) and set(entry) == {"action", "type"} and isinstance(entry["action"], str) \
+            and entry["action"] and isinstance(entry["type"], str) and entry["type"].endswith("Action") \
+            and "/" in entry["type"]:
+        return RecoveryStep(entry["action"], entry["type"])
+    raise SettingsError(f"{where}: expected a std_srvs/Trigger service name or {{action: name, type: "
+                        f"package/NameAction}}, got {entry!r}")
 
 
 class RobotStop:

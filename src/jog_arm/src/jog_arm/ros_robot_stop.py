@@ -3,8 +3,8 @@
 Subscribes to the driver topics the ``robot_stop`` parameter names, hands their values to the stage under
 the node's lock (a stop holds the arm in the same callback, before the next cycle), latches the reason on
 ``~robot_stop`` (std_msgs/String, "" while the robot runs) and serves ``~recover`` (std_srvs/Trigger): the
-driver's recovery services in order, then, once the driver reports running, commands move the arm again
-from the measured joints. The answer says what failed.
+driver's recovery steps in order (Trigger services, actions with an empty goal), then, once the driver
+reports running, commands move the arm again from the measured joints. The answer says what failed.
 """
 
 from __future__ import annotations
@@ -19,14 +19,15 @@ import rospy
 from std_msgs.msg import String
 from std_srvs.srv import Trigger, TriggerRequest, TriggerResponse
 
-from jog_arm.robot_stop import RobotStop, StopWatch, parse_robot_stop
+from jog_arm.robot_stop import RecoveryStep, RobotStop, StopWatch, parse_robot_stop
 from jog_arm.settings import SettingsError
 from jog_arm.stage import JogStage
 
 __all__ = ["RobotStopRos"]
 
 RECOVER_WAIT = 5.0  # [s] for the driver to report running after its recovery services answered
-SERVICE_WAIT = 2.0  # [s] for a recovery service to appear
+SERVICE_WAIT = 2.0  # [s] for a recovery service or action server to appear
+ACTION_WAIT = 10.0  # [s] for a recovery action's result
 
 
 def _constant_names(cls: type) -> dict[Any, str]:
@@ -48,7 +49,10 @@ class RobotStopRos:
 
     def __init__(self, stage: JogStage, lock: threading.Lock, private_ns: str, prefix: str) -> None:
         self._stage, self._lock = stage, lock
-        watches, self._services = parse_robot_stop(rospy.get_param(private_ns + "robot_stop", {}), prefix)
+        watches, self._steps = parse_robot_stop(rospy.get_param(private_ns + "robot_stop", {}), prefix)
+        for step in self._steps:  # refused at start-up, not when a stop needs it
+            if step.action_type:
+                self._message_type(step.action_type, f"{prefix}robot_stop: action {step.name}")
         self.robot = RobotStop(watches)
         self._changed = threading.Condition()
         classes = [self._message_class(w, prefix) for w in watches]
@@ -60,14 +64,12 @@ class RobotStopRos:
         self._service = rospy.Service(private_ns + "recover", Trigger, self._on_recover)
         if watches:
             rospy.loginfo("jog_arm_server: watching the robot's own stops on %s; recovery: %s",
-                          [rospy.resolve_name(w.topic) for w in watches], list(self._services) or "none")
+                          [rospy.resolve_name(w.topic) for w in watches],
+                          [rospy.resolve_name(step.name) for step in self._steps] or "none")
 
     @staticmethod
     def _message_class(watch: StopWatch, prefix: str) -> type:
-        cls: type | None = roslib.message.get_message_class(watch.type)
-        if cls is None:
-            raise SettingsError(f"{prefix}robot_stop: message type {watch.type!r} of {watch.topic} is not "
-                                "installed")
+        cls = RobotStopRos._message_type(watch.type, f"{prefix}robot_stop: {watch.topic}")
         fields = list(getattr(cls, "__slots__", ()))
         if watch.field.split(".")[0] not in fields:
             raise SettingsError(f"{prefix}robot_stop: {watch.type} has no field {watch.field!r} "
@@ -93,8 +95,8 @@ class RobotStopRos:
             reason = self.robot.reason
         if not reason:
             return TriggerResponse(success=True, message="the robot was not stopped: nothing to recover")
-        for name in self._services:
-            answer = self._call(name)
+        for step in self._steps:
+            answer = self._call(step)
             if answer is not None:
                 return TriggerResponse(success=False, message=f"{answer}; still stopped: {reason}")
         deadline = time.monotonic() + RECOVER_WAIT
@@ -112,19 +114,51 @@ class RobotStopRos:
         return TriggerResponse(success=ok, message=message)
 
     @staticmethod
-    def _call(name: str) -> str | None:
-        """Call one recovery service: None if it succeeded, else why not."""
+    def _call(step: RecoveryStep) -> str | None:
+        """Run one recovery step: None if it succeeded, else why not."""
+        name = rospy.resolve_name(step.name)
+        if step.action_type:
+            return _run_action(name, RobotStopRos._message_type(step.action_type, name))
         try:
             rospy.wait_for_service(name, timeout=SERVICE_WAIT)
             answer = rospy.ServiceProxy(name, Trigger)()
         except (rospy.ROSException, rospy.ServiceException) as err:
-            return f"{rospy.resolve_name(name)} failed: {err}"
+            return f"{name} failed: {err}"
         if not answer.success:
-            return f"{rospy.resolve_name(name)} refused: {answer.message}"
+            return f"{name} refused: {answer.message}"
         return None
+
+    @staticmethod
+    def _message_type(type_name: str, where: str) -> type:
+        cls: type | None = roslib.message.get_message_class(type_name)
+        if cls is None:
+            raise SettingsError(f"{where}: message type {type_name!r} is not installed")
+        return cls
 
     def shutdown(self) -> None:
         self._service.shutdown()
         for sub in self._subs:
             sub.unregister()
         self._pub.unregister()
+
+
+def _run_action(name: str, action: type) -> str | None:
+    """An action with an empty goal (an error recovery): None if it succeeded, else why not."""
+    import actionlib
+    from actionlib_msgs.msg import GoalStatus
+
+    client = actionlib.SimpleActionClient(name, action)
+    try:
+        if not client.wait_for_server(rospy.Duration(SERVICE_WAIT)):
+            return f"{name}: no action server within {SERVICE_WAIT:g} s"
+        goal_class = type(action().action_goal.goal)
+        client.send_goal(goal_class())
+        if not client.wait_for_result(rospy.Duration(ACTION_WAIT)):
+            client.cancel_goal()
+            return f"{name}: no result within {ACTION_WAIT:g} s"
+        state = client.get_state()
+        if state != GoalStatus.SUCCEEDED:
+            return f"{name} did not succeed (goal status {state}: {client.get_goal_status_text()})"
+        return None
+    finally:
+        client.stop_tracking_goal()

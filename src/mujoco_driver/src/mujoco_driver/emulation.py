@@ -43,6 +43,10 @@ class DriverEmulation:
         self.controllers = ControllerManager(profile.controllers, sim.arm_joint_names)
         self.model = WrenchModel(profile.wrench, len(sim.joint_names), 1.0 / profile.publish_rate)
         self.reflex = Reflex(profile.reflex.force_thresholds) if profile.reflex else None
+        # The joints for the reflex's robot state message (ros_emulation), taken with each update.
+        with_state = profile.reflex is not None and profile.reflex.state is not None
+        self.state_q, self.state_dq = np.zeros(len(sim.qpos)), np.zeros(len(sim.qpos))
+        self._with_state = with_state
         stop = profile.protective_stop
         self.stop = ProtectiveStop(stop.force_limit, stop.unlock_after) if stop else None
         self.wrench = np.zeros(6)  # what the driver publishes [N, Nm]
@@ -95,6 +99,8 @@ class DriverEmulation:
             pos[:] = r_p.T @ (p_c - p_p)
             mujoco.mju_mat2Quat(self._quat, (r_p.T @ r_c).ravel())
             quat[:] = self._quat[1], self._quat[2], self._quat[3], self._quat[0]
+        if self._with_state:
+            self.state_q[:], self.state_dq[:] = sim.qpos, sim.qvel
         if (self.reflex is not None and self.reflex.check(self.wrench)) or \
                 (self.stop is not None and self.stop.check(self.wrench, sim.time)):
             sim.set_position_targets(sim.qpos)

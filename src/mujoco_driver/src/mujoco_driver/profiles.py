@@ -20,6 +20,7 @@ profiles' YAML):
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 from collections.abc import Mapping
@@ -31,7 +32,8 @@ from compliant_common.errors import StackError
 
 from mujoco_driver.controllers import ControllerError, ControllerSpec
 
-__all__ = ["DriverProfile", "FrameLink", "ProfileError", "ProtectiveStopSpec", "ReflexSpec", "WrenchSpec",
+__all__ = ["DriverProfile", "FrameLink", "ProfileError", "ProtectiveStopSpec", "ReflexSpec", "RobotStateSpec",
+           "WrenchSpec",
            "known_profiles", "load_profile", "option_params", "profile_path", "variant_options"]
 
 PROFILE_DIR = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
@@ -121,11 +123,44 @@ class ReflexSpec:
 
     Attributes:
         force_thresholds: [fx, fy, fz, tx, ty, tz] [N, Nm].
-        recovery_action: Name of the driver_emulation_msgs/ErrorRecovery action.
+        recovery_action: Name of the recovery action (an empty goal).
+        recovery_type: Its ``package/NameAction``.
+        state: The robot state message that reports the reflex (None: none).
     """
 
     force_thresholds: tuple[float, ...]
     recovery_action: str
+    recovery_type: str
+    state: RobotStateSpec | None = None
+
+
+@dataclass(frozen=True)
+class RobotStateSpec:
+    """A driver's robot state message, published with each joint state; the emulation fills the fields
+    named here and leaves the others at their defaults.
+
+    Attributes:
+        topic, type: Where and what (``package/Message``).
+        mode_field: The robot mode's field; ``moving`` and ``stopped``: its values while the arm takes
+            commands and while the reflex holds it; ``running``: every value a real robot reports while it
+            takes commands (what a stack watching the mode accepts; ``make robot`` writes it).
+        joints, velocities: Fixed-size arrays of the joint positions and velocities (the arm's, then zeros).
+        wrench: The 6-array of the published wrench.
+        held_flags: Boolean fields (dotted paths) true while the reflex holds the arm.
+        tripped_flags: Boolean fields true once it tripped (the last motion's errors).
+    """
+
+    topic: str
+    type: str
+    mode_field: str
+    moving: int
+    stopped: int
+    joints: str
+    velocities: str
+    wrench: str
+    running: tuple[int, ...]
+    held_flags: tuple[str, ...] = ()
+    tripped_flags: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -334,6 +369,38 @@ def _check_model_errors(wrench: WrenchSpec, where: str) -> None:
                            f"{_FROM_JOINT_TORQUES}, not {wrench.model!r}")
 
 
+def _robot_state(data: Any, where: str) -> RobotStateSpec | None:
+    if data is None:
+        return None
+    if not isinstance(data, Mapping):
+        raise ProfileError(f"{where}: expected a mapping")
+    unknown = set(data) - set(RobotStateSpec.__dataclass_fields__)
+    if unknown:
+        raise ProfileError(f"{where}: unknown keys {sorted(unknown)}")
+    flags: dict[str, tuple[str, ...]] = {}
+    for key in ("held_flags", "tripped_flags"):
+        value = data.get(key, [])
+        if not (isinstance(value, list) and all(isinstance(v, str) and v for v in value)):
+            raise ProfileError(f"{where}.{key}: expected a list of field names, got {value!r}")
+        flags[key] = tuple(value)
+    modes: dict[str, int] = {}
+    for key in ("moving", "stopped"):
+        value = data.get(key)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ProfileError(f"{where}.{key}: expected the robot mode's integer value, got {value!r}")
+        modes[key] = value
+    running = data.get("running", [modes["moving"]])
+    if not (isinstance(running, list) and running and modes["moving"] in running
+            and all(isinstance(v, int) and not isinstance(v, bool) for v in running)):
+        raise ProfileError(f"{where}.running: expected a list of robot modes that includes `moving`, "
+                           f"got {running!r}")
+    name = functools.partial(_string, data, where=where)
+    return RobotStateSpec(
+        topic=name("topic"), type=name("type"), mode_field=name("mode_field"), moving=modes["moving"],
+        stopped=modes["stopped"], joints=name("joints"), velocities=name("velocities"), wrench=name("wrench"),
+        running=tuple(running), held_flags=flags["held_flags"], tripped_flags=flags["tripped_flags"])
+
+
 def _protective_stop(data: Any, where: str) -> ProtectiveStopSpec | None:
     if data is None:
         return None
@@ -448,7 +515,9 @@ def load_profile(name_or_path: str, options: Mapping[str, Any] | None = None) ->
             raise ProfileError(f"{where}.reflex.force_thresholds: expected 6 positive numbers "
                                f"[fx fy fz tx ty tz], got {thresholds!r}")
         reflex = ReflexSpec(tuple(float(v) for v in thresholds),
-                            _string(r, "recovery_action", f"{where}.reflex"))
+                            _string(r, "recovery_action", f"{where}.reflex"),
+                            _string(r, "recovery_type", f"{where}.reflex"),
+                            _robot_state(r.get("state"), f"{where}.reflex.state"))
     protective_stop = _protective_stop(data.get("protective_stop"), f"{where}.protective_stop")
     return DriverProfile(
         driver=_string(data, "driver", where),

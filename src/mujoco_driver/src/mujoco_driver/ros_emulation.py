@@ -15,16 +15,17 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+import roslib.message
 import rospy
 from geometry_msgs.msg import TransformStamped
-from std_msgs.msg import Bool, Float64, Float64MultiArray, String
+from std_msgs.msg import Bool, Float64, Float64MultiArray
 from std_srvs.srv import Trigger, TriggerResponse
 from tf2_msgs.msg import TFMessage
 from trajectory_msgs.msg import JointTrajectory
 
 from mujoco_driver.emulation import DriverEmulation
 from mujoco_driver.params import DriverSettings
-from mujoco_driver.profiles import DriverProfile, load_profile, option_params
+from mujoco_driver.profiles import DriverProfile, ProfileError, load_profile, option_params
 from mujoco_driver.sim import Simulation
 
 __all__ = ["EmulatedDriver", "PublisherFactory", "resolve_profile"]
@@ -89,7 +90,8 @@ class EmulatedDriver:
         self._scaling_msg = Float64(1.0)
         self._tf_pub: rospy.Publisher | None = None
         self._scaling_pub: rospy.Publisher | None = None
-        self._mode_pub: rospy.Publisher | None = None  # with a reflex
+        self._state_pub: rospy.Publisher | None = None  # the reflex's robot state message, if any
+        self._state_msg: Any = None
         self._recovery: Any = None  # actionlib.SimpleActionServer, with a reflex
         self._safety_pubs: tuple[rospy.Publisher, rospy.Publisher] | None = None  # with a protective stop
         self._services: list[rospy.Service] = []
@@ -123,11 +125,13 @@ class EmulatedDriver:
             self._services.append(rospy.Service(profile.wrench.zero_service, Trigger, self._on_zero))
         if profile.reflex is not None:
             import actionlib
-            from driver_emulation_msgs.msg import ErrorRecoveryAction
 
-            self._mode_pub = rospy.Publisher("~robot_mode", String, queue_size=1, latch=True)
-            self._mode_pub.publish(String("move"))
-            self._recovery = actionlib.SimpleActionServer(profile.reflex.recovery_action, ErrorRecoveryAction,
+            reflex = profile.reflex
+            if reflex.state is not None:
+                self._state_msg = _message_class(reflex.state.type)()
+                self._state_pub = publisher(reflex.state.topic, type(self._state_msg))
+            self._recovery = actionlib.SimpleActionServer(reflex.recovery_action,
+                                                          _message_class(reflex.recovery_type),
                                                           self._on_recovery, auto_start=False)
             self._recovery.start()
         if profile.protective_stop is not None:
@@ -170,6 +174,31 @@ class EmulatedDriver:
             self._tf_pub.publish(self._tf_msg)
         if self._scaling_pub is not None:
             self._scaling_pub.publish(self._scaling_msg)
+        if self._state_pub is not None:
+            self._publish_robot_state(stamp)
+
+    def _publish_robot_state(self, stamp: rospy.Time) -> None:
+        """The reflex's robot state message (profile ``reflex.state``): the robot mode, the joints and the
+        wrench as this state's, the flags of a reflex; the other fields keep their defaults."""
+        msg, emu, spec = self._state_msg, self._emu, self.profile.reflex
+        assert spec is not None and spec.state is not None and self._state_pub is not None
+        state = spec.state
+        held = emu.reflex is not None and emu.reflex.tripped
+        msg.header.stamp = stamp
+        n = len(getattr(msg, state.joints))  # a fixed-size array: the arm's joints, then zeros
+        q, dq = np.zeros(n), np.zeros(n)
+        m = min(n, len(emu.state_q))
+        q[:m], dq[:m] = emu.state_q[:m], emu.state_dq[:m]
+        setattr(msg, state.joints, q.tolist())
+        setattr(msg, state.velocities, dq.tolist())
+        setattr(msg, state.wrench, self.wrench.tolist())
+        setattr(msg, state.mode_field, state.stopped if held else state.moving)
+        for path in state.held_flags:
+            _set_field(msg, path, held)
+        for path in state.tripped_flags:
+            if held:
+                _set_field(msg, path, True)
+        self._state_pub.publish(msg)
 
     def on_reflex(self) -> None:
         """The reflex or the protective stop tripped at the last :attr:`update` (outside the lock): say so."""
@@ -180,28 +209,22 @@ class EmulatedDriver:
                          "called", stop.reason, self.profile.protective_stop.unlock_service,
                          self.profile.protective_stop.play_services[0])
             self._publish_safety()
-        if reflex is not None and reflex.tripped:
-            assert spec is not None and self._mode_pub is not None
+        if reflex is not None and reflex.tripped:  # the next robot state says so
+            assert spec is not None
             rospy.logerr("mujoco_driver: %s: the arm stopped; commands are ignored until %s is called",
                          reflex.reason, spec.recovery_action)
-            self._mode_pub.publish(String("reflex"))
 
     def reset(self) -> None:
         """Under the lock, after the simulation's reset: back at the start, so no reflex or stop either."""
-        if self._emu.reset_stops():
-            if self._mode_pub is not None:
-                self._mode_pub.publish(String("move"))
-            if self._safety_pubs is not None:
-                self._publish_safety()
+        if self._emu.reset_stops() and self._safety_pubs is not None:
+            self._publish_safety()
 
     # ------------------------------------------------------ services and action
     def _on_recovery(self, _goal: Any) -> None:
-        assert self._mode_pub is not None  # the action server exists only with a reflex
         with self._lock:
             recovered = self._emu.recover()
-        if recovered:
+        if recovered:  # the next robot state says so
             rospy.loginfo("mujoco_driver: error recovery: the arm takes commands again")
-        self._mode_pub.publish(String("move"))
         self._recovery.set_succeeded()
 
     def _on_unlock(self, _req: Any) -> TriggerResponse:
@@ -251,3 +274,21 @@ class EmulatedDriver:
         with self._lock:
             self._emu.zero()
         return TriggerResponse(success=True, message="the force/torque sensor reads zero now")
+
+
+def _message_class(type_name: str) -> type:
+    """A message (or action) class by its ``package/Name``.
+
+    Raises:
+        ProfileError: It is not installed.
+    """
+    cls: type | None = roslib.message.get_message_class(type_name)
+    if cls is None:
+        raise ProfileError(f"driver profile: message type {type_name!r} is not installed")
+    return cls
+
+
+def _set_field(msg: Any, path: str, value: object) -> None:
+    """Set a field given by a dotted path (``current_errors.cartesian_reflex``)."""
+    *parents, name = path.split(".")
+    setattr(functools.reduce(getattr, parents, msg), name, value)

@@ -36,6 +36,7 @@ from mujoco_driver.profiles import (
     DriverProfile,
     ProfileError,
     ProtectiveStopSpec,
+    ReflexSpec,
     known_profiles,
     load_profile,
     profile_path,
@@ -77,6 +78,7 @@ class DriverInterface:
         trajectory_controller: The controller named_poses sends trajectories to ("" = generic).
         trajectory_initial_state: Its state at the driver's start.
         protective_stop: The driver's safety stop and recovery (None = none; jog_arm's `robot_stop`).
+        reflex: The driver's collision reflex and recovery (None = none; jog_arm's `robot_stop`).
     """
 
     profile: str = ""
@@ -98,6 +100,7 @@ class DriverInterface:
     trajectory_controller: str = ""
     trajectory_initial_state: str = "running"
     protective_stop: ProtectiveStopSpec | None = None
+    reflex: ReflexSpec | None = None
 
     @property
     def generic(self) -> bool:
@@ -223,6 +226,7 @@ def driver_interface(driver: str) -> DriverInterface:
         jog_initial_state=jog_state,
         stop_for_jog=stop if jog_state != "running" else (),
         protective_stop=profile.protective_stop,
+        reflex=profile.reflex,
         trajectory_controller=trajectory,
         trajectory_initial_state=trajectory_state,
     )

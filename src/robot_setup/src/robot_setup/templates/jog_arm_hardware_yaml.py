@@ -39,11 +39,11 @@ low_pass_filter_coeff: 2.5
 
 def _robot_stop(d: DriverInterface) -> str:
     """jog_arm's watch of the driver's own stops (its README's *Robot stops*), for a profile that has one."""
-    stop = d.protective_stop
-    if stop is None:
-        return ""
-    return f"""
-# The robot's own stops (jog_arm README, "Robot stops"): {d.driver}'s safety mode and program state.
+    head = f"""
+# The robot's own stops (jog_arm README, "Robot stops"): {d.driver}'s """
+    if d.protective_stop is not None:
+        stop = d.protective_stop
+        return f"""{head}safety mode and program state.
 robot_stop:
   watch:
     - {{topic: {stop.safety_mode_topic}, type: ur_dashboard_msgs/SafetyMode, field: mode,
@@ -53,6 +53,18 @@ robot_stop:
     - {stop.unlock_service}
     - {stop.play_services[0]}
 """
+    if d.reflex is not None and d.reflex.state is not None:
+        state = d.reflex.state
+        running = ", ".join(str(v) for v in state.running)
+        return f"""{head}robot mode.
+robot_stop:
+  watch:
+    - {{topic: {state.topic}, type: {state.type}, field: {state.mode_field},
+       running: [{running}]}}
+  recover:
+    - {{action: {d.reflex.recovery_action}, type: {d.reflex.recovery_type}}}
+"""
+    return ""
 
 
 def _pub_period(d: DriverInterface) -> str:

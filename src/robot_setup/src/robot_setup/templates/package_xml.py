@@ -9,8 +9,14 @@ __all__ = ["package_xml"]
 
 
 def _stop_messages(plan: Plan) -> str:
-    """The message package of the driver's safety mode that jog_arm watches (jog_arm_hardware.yaml)."""
-    return "\n  <exec_depend>ur_dashboard_msgs</exec_depend>" if plan.driver.protective_stop else ""
+    """The message package of the driver's state that jog_arm watches for stops (jog_arm_hardware.yaml)."""
+    d = plan.driver
+    package = ""
+    if d.protective_stop is not None:
+        package = "ur_dashboard_msgs"
+    elif d.reflex is not None and d.reflex.state is not None:
+        package = d.reflex.state.type.split("/")[0]
+    return f"\n  <exec_depend>{package}</exec_depend>" if package else ""
 
 
 def package_xml(plan: Plan) -> str:
