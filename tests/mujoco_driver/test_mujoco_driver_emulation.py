@@ -48,6 +48,30 @@ def test_franka_profile_resolves_arm_id_and_rate_options():
         load_profile("franka_ros", {"reflex_force_thresholds": [30.0] * 5})
 
 
+def test_the_driver_stops_resolve_and_bad_entries_are_refused_by_key(tmp_path):
+    state = load_profile("franka_ros").reflex.state
+    assert (state.topic, state.type, state.mode_field) == (
+        "franka_state_controller/franka_states", "franka_msgs/FrankaState", "robot_mode")
+    assert (state.moving, state.stopped, state.running) == (2, 4, (1, 2))
+    assert state.held_flags == ("current_errors.cartesian_reflex",)
+    stop = load_profile("ur_robot_driver", {"protective_stop_force": 40.0}).protective_stop
+    assert stop.force_limit == 40.0 and stop.unlock_after == 5.0
+    base = "driver: d\npublish_rate: 10\njoint_states_topic: j\nwrench: {topic: w, frame: f, frame_link: l}\n"
+    bad = [("reflex: {force_thresholds: [1, 1, 1, 1, 1, 1], recovery_action: r, recovery_type: p/RAction, "
+            "state: {topic: t, colour: red}}", r"reflex\.state: unknown keys \['colour'\]"),
+           ("reflex: {force_thresholds: [1, 1, 1, 1, 1, 1], recovery_action: r, recovery_type: p/RAction, "
+            "state: {topic: t, type: p/S, mode_field: m, moving: 2, stopped: 4, running: [1], joints: q, "
+            "velocities: dq, wrench: w}}", r"reflex\.state\.running: .*includes `moving`"),
+           ("protective_stop: {force_limit: 1, unlock_after: 1, safety_mode_topic: s, robot_mode_topic: r, "
+            "program_running_topic: p, unlock_service: u, play_services: []}",
+            r"protective_stop\.play_services")]
+    for i, (text, message) in enumerate(bad):
+        path = tmp_path / f"bad{i}.yaml"
+        path.write_text(base + text + "\n")
+        with pytest.raises(ProfileError, match=message):
+            load_profile(str(path))
+
+
 def test_known_profiles_are_the_files_in_config_profiles():
     assert known_profiles() == ["franka_ros", "ur_robot_driver"]
     with pytest.raises(ProfileError, match=r"profiles: \['franka_ros', 'ur_robot_driver'\]"):

@@ -20,6 +20,7 @@ profiles' YAML):
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 import os
@@ -369,14 +370,22 @@ def _check_model_errors(wrench: WrenchSpec, where: str) -> None:
                            f"{_FROM_JOINT_TORQUES}, not {wrench.model!r}")
 
 
-def _robot_state(data: Any, where: str) -> RobotStateSpec | None:
+def _section(data: Any, spec: type, where: str) -> Mapping[str, Any] | None:
+    """An optional mapping whose keys are those of dataclass ``spec`` (None: absent)."""
     if data is None:
         return None
     if not isinstance(data, Mapping):
         raise ProfileError(f"{where}: expected a mapping")
-    unknown = set(data) - set(RobotStateSpec.__dataclass_fields__)
+    unknown = set(data) - {f.name for f in dataclasses.fields(spec)}
     if unknown:
         raise ProfileError(f"{where}: unknown keys {sorted(unknown)}")
+    return data
+
+
+def _robot_state(section: Any, where: str) -> RobotStateSpec | None:
+    data = _section(section, RobotStateSpec, where)
+    if data is None:
+        return None
     flags: dict[str, tuple[str, ...]] = {}
     for key in ("held_flags", "tripped_flags"):
         value = data.get(key, [])
@@ -401,14 +410,10 @@ def _robot_state(data: Any, where: str) -> RobotStateSpec | None:
         running=tuple(running), held_flags=flags["held_flags"], tripped_flags=flags["tripped_flags"])
 
 
-def _protective_stop(data: Any, where: str) -> ProtectiveStopSpec | None:
+def _protective_stop(section: Any, where: str) -> ProtectiveStopSpec | None:
+    data = _section(section, ProtectiveStopSpec, where)
     if data is None:
         return None
-    if not isinstance(data, Mapping):
-        raise ProfileError(f"{where}: expected a mapping")
-    unknown = set(data) - set(ProtectiveStopSpec.__dataclass_fields__)
-    if unknown:
-        raise ProfileError(f"{where}: unknown keys {sorted(unknown)}")
     plays = data.get("play_services")
     if not (isinstance(plays, list) and plays and all(isinstance(p, str) and p for p in plays)):
         raise ProfileError(f"{where}.play_services: expected a list of service names, got {plays!r}")
