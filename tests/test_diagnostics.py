@@ -25,10 +25,11 @@ def _result(safety: int, move: bool = False) -> CycleResult:
 
 
 def _health(safety: int = SAFETY_OK, message: str = "", period: float | None = 0.002,
-            drift: tuple[float, ...] | None = None, master: str = "", move: bool = False) -> Report:
+            drift: tuple[float, ...] | None = None, master: str = "", move: bool = False,
+            robot_stop: str = "") -> Report:
     floor = NoiseFloor((0.2,) * 6, 500.0, 500, (0.05,) * 6)
     return contact_health("/contact_control_node", SETTINGS, _result(safety, move), message, period, 0.002,
-                          0.1, floor, drift, master, False)
+                          0.1, floor, drift, master, False, robot_stop)
 
 
 def test_levels_follow_the_documented_thresholds():
@@ -49,6 +50,11 @@ def test_levels_follow_the_documented_thresholds():
     assert _health(drift=(0.0, 0.0, 0.5, 0.0, 0.0, 0.0)).level == OK
     lost = _health(master="ROS master lost: connection refused")
     assert lost.level == ERROR and "ROS master lost" in lost.message
+    stopped = _health(robot_stop="the robot stopped: x/safety_mode reads PROTECTIVE_STOP (3)")
+    assert stopped.level == WARN and stopped.message.startswith("the robot stopped: x/safety_mode reads "
+                                                                "PROTECTIVE_STOP (3): requests refused")
+    assert ("robot", "the robot stopped: x/safety_mode reads PROTECTIVE_STOP (3)") in stopped.values
+    assert ("robot", "running (no stop reported by jog_arm)") in fine.values
     text = summary([(OK, "/b", "fine", []), (ERROR, "/a", "broken", [("k", "v")])], detail=True)
     assert text.splitlines() == ["[ ERROR ] /a - broken", "    - k: v", "[ OK ] /b - fine"]
 

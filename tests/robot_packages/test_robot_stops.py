@@ -182,6 +182,13 @@ class _Cell:
                        for a in self.diagnostics.msgs for s in a.status)
 
         wait_until(named, 10, "/diagnostics to name the stop")
+
+        def contact_control_says() -> bool:  # and contact_control why it refuses (WARN, or worse beside it)
+            return any(s.level >= DiagnosticStatus.WARN and "contact_control" in s.name
+                       and any(v.key == "robot" and cell["stop"] in v.value for v in s.values)
+                       for a in self.diagnostics.msgs for s in a.status)
+
+        wait_until(contact_control_says, 10, "contact_control's /diagnostics to name the stop")
         # Standstill within 0.3 s, and jogs move nothing while stopped.
         wait_until(lambda: self.poses.last().header.stamp.to_sec() > t_stop + 0.5, 10, "0.5 s after the stop")
         self._jog(25)

@@ -3,7 +3,8 @@ its reason, the running move, the noise floor and the zero's drift (levels: the 
 
 ERROR: no wrench for the stale timeout, an invalid or over-limit wrench, a missing transform, a lost ROS
 master (the node holds the arm still in each). WARN: zeroing the sensor; the sensor's measured rate below
-RATE_WARN of the configured one (`lp_filter_delta_t`); the zero drifted more than DRIFT_WARN noise stds.
+RATE_WARN of the configured one (`lp_filter_delta_t`); the zero drifted more than DRIFT_WARN noise stds; the
+robot stopped by itself (jog_arm reports it as ERROR; requests here are refused until it recovers).
 """
 
 from __future__ import annotations
@@ -36,13 +37,15 @@ _FAULTS = (SAFETY_NAN, SAFETY_OVER_LIMIT, SAFETY_STALE, SAFETY_NO_TF)
 def contact_health(name: str, s: ContactControlSettings, result: CycleResult, message: str,
                    sample_period: float | None, wrench_age: float | None, timeout: float,
                    floor: NoiseFloor | None, drift: Sequence[float] | None, master: str,
-                   guiding: bool) -> Report:
+                   guiding: bool, robot_stop: str = "") -> Report:
     """The report; `wrench_age` [s] since the newest wrench arrived (None: none yet), `master` the lost
-    master's reason ('' while it answers)."""
+    master's reason and `robot_stop` why the robot stopped by itself ('' while it answers / runs)."""
     report = Report(name)
     safety = SAFETY_NAMES.get(result.safety, str(result.safety))
     if master:
         report.check(ERROR, master)
+    if robot_stop:
+        report.check(WARN, f"{robot_stop}: requests refused until jog_arm_server/recover")
     if result.safety in _FAULTS:
         report.check(ERROR, message or safety)
     elif result.safety == SAFETY_ZEROING:
@@ -52,6 +55,7 @@ def contact_health(name: str, s: ContactControlSettings, result: CycleResult, me
     if result.safety not in _FAULTS:  # a stale sensor's rate says nothing new
         report.check(*rate_check(measured, expected, "wrench"))
     report.value("safety", safety)
+    report.value("robot", robot_stop or "running (no stop reported by jog_arm)")
     report.value("wrench rate [Hz]", "not measured" if measured is None else f"{measured:.1f}")
     report.value("wrench rate expected [Hz]", f"{expected:.1f} (lp_filter_delta_t)")
     report.value("newest wrench age [s]", "none yet" if wrench_age is None else f"{wrench_age:.3f}")

@@ -381,10 +381,10 @@ class ContactControlRos:
             last, now = ctrl.intake.last_wrench_time, rospy.get_time()
             period, timeout = ctrl.intake.sample_period, ctrl.intake.wrench_timeout
             floor, drift = ctrl.intake.noise_floor, ctrl.intake.zero_drift
-            master, guiding = stage.master_fault, stage.guiding
+            master, guiding, stopped = stage.master_fault, stage.guiding, stage.robot_fault
         age = None if last is None else max(0.0, now - last)
         return contact_health(self._health_name, self._s, r, message, period, age, timeout, floor, drift,
-                              master, guiding)
+                              master, guiding, stopped)
 
     # --- status ---
     def _on_status(self, _event: TimerEvent | None) -> None:
