@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import math
 from collections.abc import Callable, Iterator
 
 import actionlib
@@ -18,7 +19,7 @@ from harness.waiting import wait_until
 def task_stack(args: dict | None = None) -> Iterator[tuple[Launched, actionlib.SimpleActionClient,
                                                            Callable[[], np.ndarray]]]:
     """ur5_custom's sim.launch with `args`: the launch, task_server's ExecuteTask client and the tool tip's
-    position in base_link (tf)."""
+    position and yaw in base_link (tf): x, y, z [m], yaw [rad]."""
     with run_launch("ur5_custom", "sim.launch", args or {}) as h:
         h.wait_for_service("/named_poses/move_to", timeout=40)
         client = actionlib.SimpleActionClient("/task_server/execute", ExecuteTaskAction)
@@ -28,7 +29,9 @@ def task_stack(args: dict | None = None) -> Iterator[tuple[Launched, actionlib.S
         wait_until(lambda: buffer.can_transform("base_link", "tool_tip", rospy.Time(0)), 20, "the tool's tf")
 
         def tool() -> np.ndarray:
-            p = buffer.lookup_transform("base_link", "tool_tip", rospy.Time(0)).transform.translation
-            return np.array([p.x, p.y, p.z])
+            t = buffer.lookup_transform("base_link", "tool_tip", rospy.Time(0)).transform
+            p, q = t.translation, t.rotation
+            yaw = math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+            return np.array([p.x, p.y, p.z, yaw])
 
         yield h, client, tool

@@ -1,6 +1,7 @@
 """End to end: the shipped peg_in_hole task through task_server on the simulated UR5 with the hole fixture
-and the peg tool: the hole 2.9 mm and 0.6 degrees off its nominal pose goes in; a hole 15 mm away fails the
-search with its reason and the peg backs off 20 mm."""
+and the peg tool: a hole 3.2 mm and 1.8 degrees off its nominal pose, 0.1 mm wider than the peg, goes in
+(the peg turns to the hole's yaw); a hole 15 mm away fails the search with its reason and the peg backs off
+20 mm."""
 
 from __future__ import annotations
 
@@ -21,10 +22,13 @@ PLATE_TOP = BLOCK[2] + 0.02  # the hole fixture's plate (hole_depth)
 SURFACE = 0.05  # the start pose's tool tip (z 0.20) above the plate
 
 
-def insert(rospy, offset: tuple[float, float, float]):
-    args = {"fixture": "hole", "tool": "peg", "hole_offset": f"[{offset[0]}, {offset[1]}, {offset[2]}]"}
+def insert(rospy, offset: tuple[float, float, float], clearance: float = 0.0004):
+    """The task's result, the tool (x, y, z, yaw) where it ended and the yaw it started with."""
+    args = {"fixture": "hole", "tool": "peg", "hole_offset": f"[{offset[0]}, {offset[1]}, {offset[2]}]",
+            "hole_clearance": clearance}
     with task_stack(args) as (h, client, tool):
         assert rospy.ServiceProxy("/named_poses/move_to", MoveToNamedPose)(name="start").success
+        start_yaw = tool()[3]
         client.send_goal(ExecuteTaskGoal(task="peg_in_hole", overrides=f"{{surface: {SURFACE}}}"))
         assert client.wait_for_result(rospy.Duration(120.0))
         result = client.get_result()
@@ -33,13 +37,17 @@ def insert(rospy, offset: tuple[float, float, float]):
     times = ", ".join(f"{n} {t:.1f} s" for n, t in zip(result.steps, result.step_times, strict=True))
     print(f"\npeg_in_hole, hole offset {offset}: {result.outcome}: {result.message}; {times}; "
           f"peak |F| {result.peak_force:.1f} N, |T| {result.peak_torque:.2f} Nm")
-    return result, tip
+    return result, tip, start_yaw
 
 
-def test_the_peg_goes_into_a_hole_off_its_nominal_pose(ros_node):
-    offset = (0.0025, -0.0015, math.radians(0.6))
-    result, tip = insert(ros_node, offset)
+def test_the_peg_goes_into_a_turned_hole_off_its_nominal_pose(ros_node):
+    # A 10 mm square peg turned 1.8 degrees spans 10.31 mm: it only goes into the 10.1 mm hole turned.
+    offset = (-0.0004, 0.0032, math.radians(-1.8))
+    result, tip, start_yaw = insert(ros_node, offset, clearance=0.0001)
     assert result.success, result.message
+    assert list(result.steps) == ["approach", "touch", "search", "seat", "insert"]
+    turned = math.remainder(tip[3] - start_yaw, math.tau)
+    assert abs(turned - offset[2]) < math.radians(0.6), math.degrees(turned)
     assert tip[2] <= PLATE_TOP - 0.015  # 15 mm deep
     assert np.hypot(tip[0] - BLOCK[0] - offset[0], tip[1] - BLOCK[1] - offset[1]) < 0.0008
     assert result.peak_force <= 25.0 and result.peak_torque <= 2.0
@@ -47,7 +55,7 @@ def test_the_peg_goes_into_a_hole_off_its_nominal_pose(ros_node):
 
 
 def test_a_hole_too_far_away_fails_with_the_reason_and_the_peg_backs_off(ros_node):
-    result, tip = insert(ros_node, (0.015, 0.0, 0.0))
+    result, tip, _ = insert(ros_node, (0.015, 0.0, 0.0))
     assert not result.success and result.outcome == "failed"
     assert result.message.startswith("in step 'search': the hole was not found within 6 mm"), result.message
     assert tip[2] >= PLATE_TOP + 0.02  # backed off 20 mm and more
