@@ -12,7 +12,7 @@ import numpy as np
 
 from mujoco_driver.config import Box, Hole
 
-__all__ = ["FixtureBox", "hole_boxes", "hole_offset"]
+__all__ = ["FixtureBox", "hole_boxes", "hole_offset", "hole_pose"]
 
 
 @dataclass(frozen=True)
@@ -51,6 +51,14 @@ def _ring(name: str, a: float, plate: float, z0: float, z1: float) -> list[_Part
     ]
 
 
+def hole_pose(block: Box, hole: Hole) -> tuple[float, float, float, float]:
+    """Where the hole truly is: its centre's x, y and the plate's top z in the scene's frame [m], its yaw
+    [rad] (the block's turned by the offset's)."""
+    dx, dy, dyaw = hole.offset
+    top = block.position[2] + block.size[2] / 2.0 + hole.depth
+    return block.position[0] + dx, block.position[1] + dy, top, block.rpy[2] + dyaw
+
+
 def hole_boxes(block: Box, hole: Hole) -> list[FixtureBox]:
     """The plate lying on the block's top, its hole at the top's centre moved by `hole.offset`.
 
@@ -71,11 +79,9 @@ def hole_boxes(block: Box, hole: Hole) -> list[FixtureBox]:
             ("hole_chamfer_north", (edge, side, side), (0.0, edge, -chamfer), "x"),
             ("hole_chamfer_south", (edge, side, side), (0.0, -edge, -chamfer), "x"),
         ]
-    dx, dy, dyaw = hole.offset
-    yaw = block.rpy[2] + dyaw
+    x, y, top, yaw = hole_pose(block, hole)
     c, s = math.cos(yaw), math.sin(yaw)
-    top = block.position[2] + block.size[2] / 2.0 + depth
-    origin = np.array([block.position[0] + dx, block.position[1] + dy, top])
+    origin = np.array([x, y, top])
     turn = (math.cos(yaw / 2.0), 0.0, 0.0, math.sin(yaw / 2.0))
     boxes = []
     q = math.cos(math.pi / 8.0), math.sin(math.pi / 8.0)

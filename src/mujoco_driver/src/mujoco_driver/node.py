@@ -36,6 +36,7 @@ from trajectory_msgs.msg import JointTrajectory
 
 from mujoco_driver.commands import trajectory_points, velocity_vector
 from mujoco_driver.config import ConfigError, SceneConfig
+from mujoco_driver.fixtures import hole_pose
 from mujoco_driver.health import driver_health
 from mujoco_driver.latency import LatencyProbe
 from mujoco_driver.lockstep import Lockstep
@@ -78,6 +79,8 @@ class MujocoDriverNode:
                  profile: DriverProfile | None = None) -> None:
         self._s = s = settings
         self._sim = sim = Simulation(urdf, scene_cfg)
+        if scene_cfg.hole is not None and scene_cfg.obstacle is not None:  # ground truth, for plots and tests
+            rospy.set_param("~hole_pose", list(hole_pose(scene_cfg.obstacle, scene_cfg.hole)))
         for entry in sim.scene.geometry:  # meshes converted or replaced for MuJoCo: say so, per link
             if entry.changed:
                 rospy.loginfo("mujoco_driver: collision geometry of %s", entry)

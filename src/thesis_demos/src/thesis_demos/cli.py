@@ -17,6 +17,9 @@ from thesis_demos.scenarios import SURFACE_TOLERANCE
 
 __all__ = ["main", "unresolvable"]
 
+#: The report's sections as data, which a second run (--append) adds to.
+REPORT_DATA = "report.yaml"
+
 #: run_demos' exit status when nothing failed but some demonstrations cannot be done ([CANNOT]).
 EXIT_CANNOT = 3
 
@@ -44,6 +47,9 @@ def _args(argv: Sequence[str]) -> argparse.Namespace:
                         "contact_force.drivers may set its force limit)")
     parser.add_argument("--base-frame", default="", help="default: contact_control's ~fixed_frame")
     parser.add_argument("--timeout", type=float, default=60.0, help="seconds to wait for the stack")
+    parser.add_argument("--tasks", default="/task_server", help="contact_tasks' task_server (peg in hole)")
+    parser.add_argument("--append", action="store_true", help="add to the output folder's report (a "
+                        "demonstration in a scene of its own, run in a second launch)")
     return parser.parse_args(argv)
 
 
@@ -97,10 +103,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = _args(argv)
     from thesis_demos.analysis import Verdict, judge
     from thesis_demos.geometry import DemoConfigError, robot_setup
-    from thesis_demos.plotting import plot
+    from thesis_demos.insertion import judge_task
+    from thesis_demos.plotting import plot, plot_task
     from thesis_demos.report import markdown
     from thesis_demos.runner import DemoRunner, Names
     from thesis_demos.scenarios import by_name, fitted
+    from thesis_demos.task_client import TaskFlow
 
     try:
         setup = robot_setup(args.robot, args.demos_config)
@@ -139,21 +147,28 @@ def main(argv: Sequence[str] | None = None) -> int:
             cannot[scenario.name] = reason
             print(f"[CANNOT] {scenario.name}: {reason}", flush=True)
             continue
+        png = f"{scenario.name}.png"
         try:
-            recording = runner.run(scenario, args.sensor_frame)
+            if scenario.task is not None:
+                nominal = setup.obstacle.position[:2] if setup.obstacle is not None else None
+                done = TaskFlow(runner, args.tasks, nominal).run(scenario.task, args.sensor_frame)
+                verdict = judge_task(scenario.task, done)
+                plot_task(scenario, done, verdict, os.path.join(args.output, png))
+            else:
+                recording = runner.run(scenario, args.sensor_frame)
+                verdict = judge(scenario, recording)
+                plot(scenario, recording, verdict, os.path.join(args.output, png))
         except (RuntimeError, TimeoutError) as exc:  # a refused request or no answer: the reason
             print(f"[FAIL] {scenario.name}: {exc}", flush=True)
             results.append((scenario, Verdict(False, str(exc), {}), ""))
             continue
-        verdict = judge(scenario, recording)
-        png = f"{scenario.name}.png"
-        plot(scenario, recording, verdict, os.path.join(args.output, png))
         results.append((scenario, verdict, png))
         print(f"[{'PASS' if verdict.passed else 'FAIL'}] {scenario.name}: {verdict.summary}", flush=True)
     runner.close()
     report = os.path.join(args.output, "report.md")
     with open(report, "w") as out:
-        out.write(markdown(args.robot or "robot", results, time.monotonic() - started))
+        out.write(markdown(args.robot or "robot", results, time.monotonic() - started,
+                           os.path.join(args.output, REPORT_DATA), args.append))
     print(f"report: {report}", flush=True)
     if not all(v.passed for _, v, _ in results):
         return 1

@@ -10,9 +10,12 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from thesis_demos.analysis import AXIS_INDEX, Recording, Verdict
+from thesis_demos.insertion import TaskRecording
 from thesis_demos.scenarios import SURFACE_TOLERANCE, Scenario
 
-__all__ = ["plot"]
+__all__ = ["plot", "plot_task"]
+
+PEG_HALF = 0.005  # [m] the peg tool's half width (mujoco_driver tool:=peg)
 
 
 def _velocity(t: np.ndarray, y: np.ndarray, span: float = 0.05) -> tuple[np.ndarray, np.ndarray]:
@@ -106,6 +109,40 @@ def plot(scenario: Scenario, rec: Recording, verdict: Verdict, path: str) -> Non
     ax_p.set_xlabel("time since the law was set [s]  (shaded: push; dashed: move ended)")
     mark = "PASS" if verdict.passed else "FAIL"
     fig.suptitle(f"{scenario.title}\n{mark}: {verdict.summary}", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def plot_task(scenario: Scenario, rec: TaskRecording, verdict: Verdict, path: str) -> None:
+    """Peg in hole: the tool's path from above with the true hole and the nominal one, then |F| and the depth
+    past the touch point over time, a colour per step."""
+    fig, (ax_xy, ax_f, ax_d) = plt.subplots(3, 1, figsize=(9, 10), gridspec_kw={"height_ratios": [3, 2, 2]})
+    centre = np.asarray(rec.nominal)
+    square = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]], dtype=float) * PEG_HALF
+    c, s = np.cos(rec.hole[3]), np.sin(rec.hole[3])
+    hole = square @ np.array([[c, s], [-s, c]]) + np.asarray(rec.hole[:2]) - centre
+    ax_xy.plot(*(hole * 1e3).T, color="black", linewidth=2, label="the hole (true pose)")
+    ax_xy.plot(*(square * 1e3).T, color="grey", linestyle="--", linewidth=1, label="where it was said to be")
+    if len(rec.pose):
+        ax_xy.plot(*((rec.pose[:, :2] - centre) * 1e3).T, linewidth=1, label="tool tip")
+    t = rec.feedback_t
+    for name in dict.fromkeys(rec.feedback_step):
+        keep = np.array([step == name for step in rec.feedback_step])
+        ax_f.plot(t[keep], rec.force[keep], ".", markersize=3, label=name)
+        ax_d.plot(t[keep], rec.depth[keep] * 1e3, ".", markersize=3, label=name)
+    ax_f.axhline(scenario.task.max_force if scenario.task else 0.0, color="red", linestyle="--", linewidth=1)
+    ax_xy.set_aspect("equal", adjustable="datalim")
+    ax_xy.set_xlabel("x from the nominal hole [mm]")
+    ax_xy.set_ylabel("y [mm]")
+    ax_f.set_ylabel("|F| [N] (dashed: the limit)")
+    ax_d.set_ylabel("depth past the touch [mm]")
+    ax_d.set_xlabel("time since the task began [s]")
+    for ax in (ax_xy, ax_f, ax_d):
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="upper right", fontsize=8)
+    fig.suptitle(f"{scenario.title}\n{'PASS' if verdict.passed else 'FAIL'}: {verdict.summary}", fontsize=8,
+                 wrap=True)
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)

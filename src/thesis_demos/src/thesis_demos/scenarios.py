@@ -1,5 +1,5 @@
-"""The four thesis demonstrations, a fifth (surface following) and a sixth (teach and replay) as data: laws,
-pushes, what to judge.
+"""The four thesis demonstrations, a fifth (surface following), a sixth (teach and replay) and a seventh (peg
+in hole, a contact_tasks task) as data: laws, pushes, what to judge.
 
 Pure: no rospy. Forces are in the robot's base frame [N]; velocities [m/s]; distances [m].
 """
@@ -12,8 +12,8 @@ from dataclasses import dataclass, field
 
 from thesis_demos.geometry import SURFACE_DIRECTION, SURFACE_TRAVEL, DemoGeometry, RobotSetup, fit_l
 
-__all__ = ["SCENARIOS", "AxisLaw", "FollowUp", "Push", "Scenario", "TeachL", "build_scenarios", "by_name",
-           "fitted"]
+__all__ = ["SCENARIOS", "AxisLaw", "FollowUp", "Push", "Scenario", "TaskDemo", "TeachL", "build_scenarios",
+           "by_name", "fitted", "peg_in_hole"]
 
 AXES = ("x", "y", "z", "rx", "ry", "rz")
 # cartesian_impedance_msgs/ControlLaw
@@ -76,6 +76,21 @@ class TeachL:
 
 
 @dataclass(frozen=True)
+class TaskDemo:
+    """A task of contact_tasks' tasks folder, the scene it needs and what it must achieve.
+
+    `scene`: the robot package's sim.launch arguments for it (also the emulated driver's), as pairs.
+    """
+
+    task: str
+    scene: tuple[tuple[str, str], ...]
+    depth: float = 0.015  # [m] inserted at least this far past the plate's top
+    within: float = 45.0  # [s] the task's whole time at most
+    max_force: float = 25.0  # [N] peak |F|
+    max_torque: float = 2.0  # [Nm] peak |T|
+
+
+@dataclass(frozen=True)
 class Scenario:
     """A demonstration: laws, pushes, how long to record, and the axes that matter."""
 
@@ -93,6 +108,12 @@ class Scenario:
     follow_up: FollowUp | None = None  # a second request during the run (surface following: the X move)
     teach: TeachL | None = None  # the L taught by hand (its own flow: thesis_demos.teach_client)
     press_force: float = 0.0  # [N] force tracking's target on a pressed replay (0: none)
+    task: TaskDemo | None = None  # a contact_tasks task in a scene of its own (its own flow: task_client)
+
+    @property
+    def scene(self) -> tuple[tuple[str, str], ...]:
+        """The sim.launch arguments this demonstration needs beyond the robot package's scene."""
+        return self.task.scene if self.task is not None else ()
 
     @property
     def uses_laws_service(self) -> bool:
@@ -184,6 +205,7 @@ def build_scenarios(geometry: DemoGeometry | None = None) -> tuple[Scenario, ...
         ),
         surface_following(),
         teach_and_replay(),
+        peg_in_hole(),
     )
 
 
@@ -268,6 +290,28 @@ def teach_and_replay(
         exceeded_action="move_away",
         teach=TeachL(corner, legs),
         press_force=SURFACE_TARGET_FORCE,
+    )
+
+
+# Peg in hole (the seventh demonstration): contact_tasks' shipped task, unchanged, on the hole fixture with
+# the peg tool. The hole is drawn from a seed within 4 mm and 2 degrees of the block's top centre
+# (mujoco_driver's hole_seed): the task is told only where the plate's top would be.
+PEG_HOLE_SEED = 1
+PEG_HOLE_CLEARANCE = 0.0004  # [m] a 10.4 mm hole for the 10 mm peg
+
+
+def peg_in_hole() -> Scenario:
+    """The seventh demonstration (not in the thesis): search, seat and insert under position uncertainty."""
+    scene = (("fixture", "hole"), ("tool", "peg"), ("hole_seed", str(PEG_HOLE_SEED)),
+             ("hole_clearance", str(PEG_HOLE_CLEARANCE)))
+    return Scenario(
+        name="peg_in_hole",
+        title=f"Peg in hole: a 10 mm square peg into a {10 + PEG_HOLE_CLEARANCE * 1e3:g} mm hole off its "
+        "nominal pose (contact_tasks' peg_in_hole task)",
+        laws={},
+        duration=45.0,
+        controlled=("x", "y", "z"),
+        task=TaskDemo("peg_in_hole", scene),
     )
 
 

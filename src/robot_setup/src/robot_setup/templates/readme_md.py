@@ -44,7 +44,7 @@ same command (the same files come out), check with `make check-robot ROBOT={name
 ```bash
 scripts/with_env roslaunch {pkg} sim.launch            # headless; viewer:=true for a window
 scripts/with_env roslaunch {pkg} sim.launch viewer:=rviz   # RViz on config/view.rviz (compliant_rviz)
-make demo ROBOT={name}                                  # the six demonstrations
+make demo ROBOT={name}                                  # the seven demonstrations
 scripts/with_env rosservice call /named_poses/move_to "{{name: home}}"
 ```
 
