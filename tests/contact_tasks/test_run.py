@@ -72,6 +72,24 @@ def test_the_force_ceiling_fails_the_task_at_once_and_the_retract_runs():
     assert loop.pose[2, 3] > 0.015  # the default retract's 20 mm from the plate
 
 
+def test_steps_that_lead_back_to_each_other_end_at_the_tasks_time_limit_and_retract():
+    """Two steps sending the tool to each other forever: the time limit fails the task and it backs off."""
+    task = parse_task({
+        "task": "ping_pong", "time_limit": 3.0,
+        "steps": {
+            "ping": {"exits": [{"when": "timeout", "after": 0.4, "next": "pong"}]},
+            "pong": {"exits": [{"when": "timeout", "after": 0.4, "next": "ping"}]},
+        },
+    })
+    loop = TaskLoop(TaskRun(task), HoleWorld(hole=(0.02, 0.0)), START)
+    end = loop.go(10.0)
+    assert end.outcome == FAILED
+    assert end.reason.endswith("the task ran longer than its time limit 3 s (retract: retracted)"), end.reason
+    times = loop.run.result.step_times
+    assert times["ping"] + times["pong"] == pytest.approx(3.0, abs=0.05)
+    assert loop.pose[2, 3] > 0.025  # the retract's 20 mm above the start
+
+
 def test_an_on_failure_step_runs_instead_of_the_retract_and_the_task_still_fails():
     task = parse_task({
         "task": "wait_then_lift", "on_failure": "lift",

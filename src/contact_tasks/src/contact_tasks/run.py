@@ -119,6 +119,7 @@ class TaskRun:
         self._frame = np.eye(3)
         self._touch: FloatArray | None = None
         self._origin: FloatArray | None = None  # the tool's position at the task's start
+        self._started = 0.0  # [s] obs.t at the task's start
         self._since: dict[int, float] = {}  # exit index -> when its threshold began to hold
         self._failing = ""  # the task's failure reason while its on-failure step runs
         sign = -1.0 if task.approach.startswith("-") else 1.0
@@ -132,6 +133,7 @@ class TaskRun:
     def start(self, obs: Observation) -> Command:
         """Begins the task's first step at `obs`."""
         self._origin = obs.tool[:3, 3].copy()
+        self._started = obs.t
         return self._begin(self.task.start, self.task.steps[self.task.start], obs)
 
     def update(self, obs: Observation) -> Command:
@@ -159,6 +161,9 @@ class TaskRun:
                     if force > task.force_ceiling else
                     f"|T| {torque:.2f} Nm above the task's torque ceiling {task.torque_ceiling:g} Nm")
             return self._fail(f"in step '{self.step_name}': {over}", obs)
+        if not self._failing and 0.0 < task.time_limit < obs.t - self._started:
+            return self._fail(f"in step '{self.step_name}': the task ran longer than its time limit "
+                              f"{task.time_limit:g} s", obs)
         step_t = obs.t - self._step_t
         point = evaluate(self._step.pattern, step_t)
         self.search_radius = point.radius

@@ -151,6 +151,7 @@ class Task:
     surface: float | None = None
     force_ceiling: float = 25.0
     torque_ceiling: float = 2.0
+    time_limit: float = 0.0
     on_failure: str = ""
     retract: Retract = field(default_factory=Retract)
     description: str = ""
@@ -171,6 +172,8 @@ class _TaskKeys:
     )
     force_ceiling: float = param(25.0, unit="N", gt=0.0, doc="|F| above this fails the task at once")
     torque_ceiling: float = param(2.0, unit="Nm", gt=0.0, doc="|T| above this fails the task at once")
+    time_limit: float = param(0.0, unit="s", ge=0.0, doc="the task fails when it has run this long (0: no "
+                              "limit); it bounds steps that lead back to each other")
     on_failure: str = param("", doc="a step run when the task fails (default: the built-in retract)")
     body_region: str = param(
         "", choices=("", OFF, *REGIONS),

@@ -140,6 +140,7 @@ class _Parser:
             surface=keys.get("surface"),  # type: ignore[arg-type]
             force_ceiling=float(keys.get("force_ceiling", 25.0)),  # type: ignore[arg-type]
             torque_ceiling=float(keys.get("torque_ceiling", 2.0)),  # type: ignore[arg-type]
+            time_limit=float(keys.get("time_limit", 0.0)),  # type: ignore[arg-type]
             on_failure=str(keys.get("on_failure", "")),
             retract=retract,
             description=str(keys.get("description", "")),
