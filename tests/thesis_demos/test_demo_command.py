@@ -47,6 +47,25 @@ def test_surface_following_through_the_emulated_ur_robot_driver_is_recorded(tmp_
     assert abs(np.median(np.diff(stamps)) - 1.0 / 125.0) < 0.001  # CB3's 125 Hz
 
 
+@pytest.mark.e2e  # scripts/demo runs the simulation, twice
+def test_peg_in_hole_runs_in_its_own_scene_through_the_emulated_franka_ros_and_joins_the_report(tmp_path):
+    """The seventh demonstration needs the hole fixture and the peg tool: make demo relaunches the emulated
+    franka_ros with them after the others, and its section joins the same report."""
+    command = _demo("--robot", "panda", "--driver", "franka_ros", "--only", "spring_x", "peg_in_hole",
+                    "--bias-map", "none", "--output", str(tmp_path))
+    run = _run(command, capture_output=True, text=True, timeout=400, check=False)
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    assert "[demo] running the demonstrations: spring_x\n" in run.stdout
+    assert "[demo] relaunching with fixture:=hole tool:=peg hole_seed:=1" in run.stdout
+    said = (r"^\[PASS\] peg_in_hole: hole \+2\.7, -0\.9 mm and -1\.4 deg from nominal, not told to the "
+            r"task; task succeeded: inserted 15 mm; (\d+\.\d) mm deep")
+    verdict = re.search(said, run.stdout, re.M)
+    assert verdict and float(verdict.group(1)) >= 15.0, run.stdout
+    report = (tmp_path / "report.md").read_text()
+    assert "2 of 2 passed" in report and "## Spring law on X" in report and "## Peg in hole" in report
+    assert (tmp_path / "peg_in_hole.png").exists() and (tmp_path / "spring_x.png").exists()
+
+
 def test_driver_options_without_a_driver_are_refused_before_anything_launches(tmp_path):
     command = _demo("--robot", "ur5", "--driver-options", "{series: e_series}", "--output", str(tmp_path))
     run = _run(command, capture_output=True, text=True, timeout=120, check=False)
