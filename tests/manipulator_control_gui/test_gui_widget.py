@@ -91,6 +91,7 @@ def names_in(ns: str) -> RosNames:
         "~configure_service": f"{ns}/configure_cartesian_impedance",
         "~teach_node": f"{ns}/teach",
         "~recover_service": f"{ns}/jog_arm_server/recover",
+        "~task_server": f"{ns}/task_server",
     }
     return RosNames.from_params(lambda key, default: params.get(key, default))
 
@@ -547,3 +548,55 @@ def test_teach_box_records_stops_and_replays_through_program_server(fake, ns, ma
         assert widget.answer_label.text().startswith("Replay done")
     finally:
         teach.close()
+
+
+class FakeTaskServer:
+    """task_server's ~execute action: feedback in step 'search' until cancelled, which it reports."""
+
+    def __init__(self, rospy, ns: str) -> None:
+        import actionlib
+        from compliant_control_msgs.msg import ExecuteTaskAction
+
+        self.rospy = rospy
+        self.server = actionlib.SimpleActionServer(f"{ns}/task_server/execute", ExecuteTaskAction,
+                                                   self._execute, auto_start=False)
+        self.server.start()
+
+    def _execute(self, goal) -> None:
+        from compliant_control_msgs.msg import ExecuteTaskFeedback, ExecuteTaskResult
+
+        feedback = ExecuteTaskFeedback(step="search", elapsed=0.0, depth=0.0003, search_radius=0.0021)
+        feedback.wrench.force.z = 7.0
+        while not self.server.is_preempt_requested() and not self.rospy.is_shutdown():
+            feedback.elapsed += 0.1
+            self.server.publish_feedback(feedback)
+            self.rospy.sleep(0.1)  # the fake task's pace
+        self.server.set_preempted(ExecuteTaskResult(outcome="cancelled", message="cancelled in step 'search'",
+                                                    steps=["approach", "search"], step_times=[1.5, 2.0],
+                                                    peak_force=8.2, peak_torque=0.05))
+
+
+def test_task_box_shows_a_task_another_client_runs_and_cancels_it(fake, ns, make_widget, pump, ros_node):
+    """A task started from the command line shows its step and numbers; Cancel task ends it."""
+    import actionlib
+    from compliant_control_msgs.msg import ExecuteTaskAction, ExecuteTaskGoal
+
+    tasks = FakeTaskServer(ros_node, ns)
+    widget = make_widget(ns)
+    box = widget.task_box
+    assert box.task_label.text() == "no task yet" and not box.cancel_button.isEnabled()
+    client = actionlib.SimpleActionClient(f"{ns}/task_server/execute", ExecuteTaskAction)
+    assert client.wait_for_server(ros_node.Duration(10.0))
+    pump(lambda: widget.client._task_cancel.get_num_connections() > 0, message="Cancel's link to the server")
+    client.send_goal(ExecuteTaskGoal(task="peg_in_hole"))
+    pump(lambda: "step search" in box.task_label.text(), message="the task's feedback")
+    assert box.task_label.text().startswith("peg_in_hole: step search, ")
+    assert box.task_label.text().endswith(" s, |F| 7.0 N, depth 0.3 mm, search radius 2.1 mm")
+    assert box.cancel_button.isEnabled()
+    click(box.cancel_button)
+    assert client.wait_for_result(ros_node.Duration(10.0))
+    assert client.get_result().outcome == "cancelled"
+    pump(lambda: "cancelled" in box.task_label.text(), message="the task's result")
+    assert box.task_label.text() == ("peg_in_hole: cancelled: cancelled in step 'search' (3.5 s, peak |F| "
+                                     "8.2 N, |T| 0.05 Nm)")
+    assert not box.cancel_button.isEnabled() and not tasks.server.is_active()

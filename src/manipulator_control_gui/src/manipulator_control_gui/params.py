@@ -50,6 +50,11 @@ class GuiSettings:
         "teach", nonempty=True,
         doc="teach's program_server: the Teach box calls its `~record`, `~stop` and `~replay`",
     )
+    task_server: str = param(
+        "task_server", nonempty=True,
+        doc="contact_tasks' task_server: the Task box shows the running task's step from its `~execute` "
+        "action's feedback and result, and its Cancel cancels it",
+    )
     retry_period: float = param(1.0, unit="s", gt=0.0, doc="how often the panel looks for the services")
 
 

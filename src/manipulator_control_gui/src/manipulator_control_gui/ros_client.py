@@ -35,6 +35,7 @@ class RosNames:
     status_topic: str = f"{_NODE}/status"
     recover_service: str = GuiSettings.recover_service
     teach_node: str = GuiSettings.teach_node
+    task_server: str = GuiSettings.task_server
     #: compliant_control_msgs/ConfigureLaws, used instead of configure_service when registered (it answers
     #: with the reason of a refusal).
     laws_service: str = "configure_laws"
@@ -55,6 +56,7 @@ class RosNames:
             status_topic=settings.status_topic or f"{node}/status",
             recover_service=settings.recover_service,
             teach_node=settings.teach_node,
+            task_server=settings.task_server,
             laws_service=settings.configure_laws_service or f"{namespace}{slash}{cls.laws_service}",
         )
 
@@ -133,6 +135,8 @@ class ContactControlClient:
         self._sub = None
         self._last: Availability | None = None
         self._replay_client: Any = None
+        self._task_subs: list[Any] = []
+        self._task_cancel: Any = None
 
     def start(self) -> None:
         """Subscribes to the status and starts watching the services."""
@@ -144,12 +148,49 @@ class ContactControlClient:
         self._watcher = threading.Thread(target=self._watch, name="mcg-service-watcher", daemon=True)
         self._watcher.start()
 
+    def follow_tasks(self, on_goal: Callable[[Any], None], on_feedback: Callable[[Any], None],
+                     on_result: Callable[[Any], None]) -> None:
+        """Follows task_server's `~execute` action as any client may (its goal, feedback and result
+        topics), whoever sent the goal; the callbacks get the messages' goal, feedback and result from rospy
+        threads."""
+        from actionlib_msgs.msg import GoalID
+        from compliant_control_msgs.msg import (
+            ExecuteTaskActionFeedback,
+            ExecuteTaskActionGoal,
+            ExecuteTaskActionResult,
+        )
+
+        action = self.resolved.task_server + "/execute"
+        # Made now, so it is connected to task_server long before someone presses Cancel.
+        self._task_cancel = self._rospy.Publisher(f"{action}/cancel", GoalID, queue_size=1)
+        self._task_subs = [
+            self._rospy.Subscriber(f"{action}/goal", ExecuteTaskActionGoal, lambda m: on_goal(m.goal),
+                                   queue_size=5),
+            self._rospy.Subscriber(f"{action}/feedback", ExecuteTaskActionFeedback,
+                                   lambda m: on_feedback(m.feedback), queue_size=1),
+            self._rospy.Subscriber(f"{action}/result", ExecuteTaskActionResult, lambda m: on_result(m.result),
+                                   queue_size=5),
+        ]
+
+    def cancel_task(self) -> None:
+        """Cancels every goal of task_server's `~execute` (actionlib: an empty GoalID on `cancel`), the one a
+        command line or another program started included."""
+        from actionlib_msgs.msg import GoalID
+
+        if self._task_cancel is not None:
+            self._task_cancel.publish(GoalID())
+
     def shutdown(self) -> None:
         """Stops the watcher and unsubscribes; calls in flight finish on their own."""
         self._stop.set()
         if self._sub is not None:
             self._sub.unregister()
             self._sub = None
+        for sub in self._task_subs:
+            sub.unregister()
+        self._task_subs = []
+        if self._task_cancel is not None:
+            self._task_cancel.unregister()
         if self._watcher is not None:
             self._watcher.join(timeout=2.0)
 

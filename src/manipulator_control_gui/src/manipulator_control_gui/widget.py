@@ -38,6 +38,7 @@ from manipulator_control_gui.form import (
 from manipulator_control_gui.form_config import AXES, AXIS_LABELS, FIELDS, LAW_FIELDS, LAWS, GuiConfig
 from manipulator_control_gui.readout import readout_from_status, refusal_in_status
 from manipulator_control_gui.ros_client import Availability, CallResult, ContactControlClient, RosNames
+from manipulator_control_gui.task_box import TaskBox
 from manipulator_control_gui.teach_box import TeachBox
 
 __all__ = ["ControlWidget"]
@@ -66,6 +67,7 @@ class _Bridge(QObject):
     status = Signal(object)
     availability = Signal(object)
     answer = Signal(str, object)
+    task = Signal(str, object)  # ("goal" | "feedback" | "result", the action's message part)
 
     def __init__(self) -> None:
         super().__init__()
@@ -83,7 +85,7 @@ class _Bridge(QObject):
     def close(self) -> None:
         """No more deliveries: the widget is going away."""
         self._closed = True
-        for signal in (self.status, self.availability, self.answer):
+        for signal in (self.status, self.availability, self.answer, self.task):
             try:
                 signal.disconnect()
             except TypeError:  # nothing connected
@@ -182,6 +184,12 @@ class ControlWidget(QWidget):
             self.client, lambda which, result: self._bridge.send("answer", which, result), self
         )
         self._layout.insertWidget(self._layout.indexOf(self.answer_label), self.teach_box)
+        self.task_box = TaskBox(self.client.cancel_task, self)
+        self._layout.insertWidget(self._layout.indexOf(self.answer_label), self.task_box)
+        self._bridge.task.connect(self._show_task)
+        self.client.follow_tasks(lambda goal: self._bridge.send("task", "goal", goal),
+                                 lambda feedback: self._bridge.send("task", "feedback", feedback),
+                                 lambda result: self._bridge.send("task", "result", result))
         self._status_timer = QTimer(self)
         self._status_timer.timeout.connect(self._check_status_age)
         self._status_timer.start(250)
@@ -422,6 +430,10 @@ class ControlWidget(QWidget):
         self._laws_service = availability.ok and availability.laws
         self.connection_label.setText(text)
         self.connection_label.setStyleSheet(style)
+
+    def _show_task(self, part: str, message: Any) -> None:
+        {"goal": self.task_box.show_goal, "feedback": self.task_box.show_feedback,
+         "result": self.task_box.show_result}[part](message)
 
     def _show_status(self, status: Any) -> None:
         readout = readout_from_status(status)
