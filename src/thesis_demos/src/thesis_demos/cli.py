@@ -143,6 +143,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         if scenario.name in cannot:
             continue
         reason = unresolvable(scenario, floor, sigmas, global_force, pose)
+        if scenario.task is not None and not runner.has_hole():
+            reason = ("this scene has no hole fixture (make demo runs it in a second launch with "
+                      f"{' '.join(f'{k}:={v}' for k, v in scenario.scene)})")
         if reason:  # the sensor cannot tell this demonstration's force limit from its noise
             cannot[scenario.name] = reason
             print(f"[CANNOT] {scenario.name}: {reason}", flush=True)

@@ -281,6 +281,10 @@ class StackClient:
         with self.pose.lock:
             return np.asarray(self.pose.v[-1], dtype=float)
 
+    def has_hole(self) -> bool:
+        """Whether the simulated scene has the hole fixture (the driver's ground truth `~hole_pose`)."""
+        return rospy.has_param(f"{self.names.driver}/hole_pose")
+
     def contact_setting(self, name: str) -> float:
         """contact_control's parameter `name` as the node reads it (its default if unset)."""
         default = getattr(ContactControlSettings, name)
