@@ -133,3 +133,14 @@ def test_a_master_coming_back_does_not_lift_a_robot_stop(robot: Robot):
     cell.stage.robot_recovered()
     cell.run(0.05)
     assert cell.cycles[-1].status != StatusCode.ROBOT_STOPPED
+
+
+def test_a_recovery_while_the_master_is_lost_still_refuses_naming_the_master(robot: Robot):
+    cell = HeldCell(robot)
+    cell.stage.suspend("the ROS master is gone")
+    cell.stage.robot_stopped("the robot stopped: x")
+    cell.stage.robot_recovered()
+    cell.run(0.05)
+    last = cell.cycles[-1]
+    assert last.status != StatusCode.ROBOT_STOPPED and "master is gone" in last.message, last.message
+    assert not any(c.publish and any(c.velocities) for c in cell.cycles)  # held all along

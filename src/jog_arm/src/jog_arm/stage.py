@@ -410,7 +410,9 @@ class JogStage:
         """The driver runs again and recovery was asked for: commands move the arm again, from the measured
         joints."""
         self.robot_stop = ""
-        if not self.suspended:
+        if self.suspended:  # still suspended (the master lost): the refusal names that again, not the stop
+            self.jog.suspend(self.suspended)
+        else:
             self.jog.unsuspend()
 
     @property
