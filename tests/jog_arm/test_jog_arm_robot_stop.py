@@ -61,6 +61,18 @@ def test_a_stop_is_latched_until_the_driver_runs_and_recovery_is_asked_for():
     assert stop.recover() == (True, "the robot was not stopped")
 
 
+def test_the_cause_listed_first_names_the_stop_whichever_topic_brings_the_news_first():
+    """The program stops with a protective stop; its topic may arrive first: the safety mode, listed before
+    it, then names the stop. A consequence arriving after the cause changes nothing."""
+    stop = RobotStop(parse_robot_stop(UR)[0])
+    assert not stop.update(0, 1, "NORMAL") and not stop.update(1, True)
+    assert stop.update(1, False) and "robot_program_running reads False" in stop.reason
+    assert stop.update(0, 3, "PROTECTIVE_STOP") and "safety_mode reads PROTECTIVE_STOP (3)" in stop.reason
+    assert not stop.update(1, False) and "PROTECTIVE_STOP" in stop.reason
+    assert not stop.update(0, 1, "NORMAL") and not stop.update(1, True) and stop.recover()[0]
+    assert stop.update(1, False) and "robot_program_running" in stop.reason  # after recovery: anew
+
+
 def test_a_robot_not_started_yet_is_reported_and_clears_by_itself_once_it_runs():
     stop = RobotStop([StopWatch("program_running", "std_msgs/Bool", "data", (True,))])
     assert stop.state() == "program_running: not heard yet" and stop.driver_running()

@@ -123,14 +123,21 @@ class _Cell:
             rate.sleep()  # the sender's rate, not a wait for a result
 
     def _stopped_after(self, before: int) -> float:
-        """The stamp of jog_arm's first ROBOT_STOPPED status after message ``before``, waiting for it."""
+        """The stamp of jog_arm's first ROBOT_STOPPED status after message ``before``, waiting for it; within
+        0.5 s of it the status names the stop's cause (the UR's program state may bring the news first)."""
         def seen() -> bool:
             return any(m.code == JogStatus.ROBOT_STOPPED for m in self.jog.msgs[before:])
 
         wait_until(seen, 10, "jog_arm to report the robot stopped")
         first = next(m for m in self.jog.msgs[before:] if m.code == JogStatus.ROBOT_STOPPED)
-        assert self.cell["stop"] in first.message, first.message
-        return first.header.stamp.to_sec()
+        t_stop = first.header.stamp.to_sec()
+
+        def named() -> bool:
+            return any(m.code == JogStatus.ROBOT_STOPPED and self.cell["stop"] in m.message
+                       and m.header.stamp.to_sec() <= t_stop + 0.5 for m in self.jog.msgs[before:])
+
+        wait_until(named, 5, f"jog_arm's status to name {self.cell['stop']}")
+        return t_stop
 
     def _recover_when_allowed(self, t_stop: float) -> None:
         if self.cell["profile"] == "ur_robot_driver":  # the dashboard's wait
@@ -168,7 +175,8 @@ class _Cell:
             early = self.recover()
             assert not early.success and "Cannot unlock protective stop" in early.message, early.message
         # contact_control's move ended with the reason; a new request is refused, a named-pose move too.
-        ended = lambda: any(e.type == ContactEvent.MOVE_ENDED and cell["stop"] in e.message  # noqa: E731
+        # (its event carries the first news: the UR's program state may come before the safety mode)
+        ended = lambda: any(e.type == ContactEvent.MOVE_ENDED and "the robot stopped" in e.message  # noqa: E731
                             for e in self.events.msgs)
         wait_until(ended, 5, "contact_control's move to end naming the stop")
         wait_until(lambda: not self.cc.last().move_active, 5, "contact_control's status to show no move")

@@ -95,26 +95,27 @@ class RobotStop:
         self._names: list[str] = [""] * len(self.watches)
         self._ever_running = False
         self._latched_since_start = False  # the stop was there before the driver ever reported running
+        self._cause = len(self.watches)  # the watch the reason names
         #: Why the robot stopped ("" = it did not, or it recovered).
         self.reason = ""
 
     def update(self, index: int, value: object, name: str = "") -> bool:
-        """Topic ``index`` reads ``value`` (``name``: its constant's name, if any); True exactly when this
-        makes a stop (not already latched)."""
+        """Topic ``index`` reads ``value`` (``name``: its constant's name, if any); True when this makes a
+        stop, or names it better: a watch listed earlier stops too (a package lists the cause, e.g. the
+        safety mode, before its consequences, e.g. the program stopped, which may arrive first)."""
         self._values[index], self._names[index] = value, name
         if self.driver_running():
             self._ever_running = True
             if self.reason and self._latched_since_start:
-                self.reason = ""  # the robot was not started yet; now it is
-            return False
-        if self.reason:
+                self.reason, self._cause = "", len(self.watches)  # not started yet; now it is
             return False
         watch = self.watches[index]
-        if value in watch.running:
+        if value in watch.running or (self.reason and index >= self._cause):
             return False
         shown = f"{name} ({value})" if name else repr(value)
-        self.reason = f"the robot stopped: {watch.topic} reads {shown}"
-        self._latched_since_start = not self._ever_running
+        if not self.reason:
+            self._latched_since_start = not self._ever_running
+        self.reason, self._cause = f"the robot stopped: {watch.topic} reads {shown}", index
         return True
 
     def driver_running(self) -> bool:
@@ -135,5 +136,5 @@ class RobotStop:
             return True, "the robot was not stopped"
         if not self.driver_running():
             return False, f"the driver still reports a stop ({self.state()})"
-        was, self.reason = self.reason, ""
+        was, self.reason, self._cause = self.reason, "", len(self.watches)
         return True, f"recovered from: {was}"
