@@ -10,6 +10,7 @@ real driver through an :class:`~mujoco_driver.ros_emulation.EmulatedDriver` it o
 from __future__ import annotations
 
 import faulthandler
+import logging
 import math
 import os
 import signal
@@ -58,6 +59,7 @@ _MAX_STAMP_AHEAD = 1.0  # [s] stamps further in the future too
 # contact_control's measured wrench rate, so its filter design, between ~0.9 and 1 kHz).
 _CATCH_UP_LAG = 0.002
 _LOCKSTEP_SLICE = 0.005  # [s] a lockstep wait wakes this often to publish and to see a stop
+VIEWER_CLOSE_WAIT = 3.0  # [s] the viewer's close may take (its render thread answers within a frame)
 
 
 class MujocoDriverNode:
@@ -178,6 +180,7 @@ class MujocoDriverNode:
         if self._driver is not None:
             self._driver.advertise(publisher)
         self._viewer = self._open_viewer() if s.viewer else None
+        self._viewer_opened = self._viewer is not None
         self._warned: dict[str, int] = {}
         self._last_warning: dict[str, float] = {}
         self._stop_requested = False
@@ -272,7 +275,19 @@ class MujocoDriverNode:
                 next_view = now + s.viewer_period
                 self._sync_viewer()
         if self._viewer is not None:
-            self._viewer.close()
+            # Closing waits for the viewer's render thread; bounded, as a GL thread that never answers would
+            # hold the driver (and roslaunch's shutdown) until killed.
+            closer = threading.Thread(target=self._viewer.close, name="viewer-close", daemon=True)
+            closer.start()
+            closer.join(VIEWER_CLOSE_WAIT)
+            if closer.is_alive():
+                rospy.logwarn("mujoco_driver: the viewer did not close within %g s; exiting without it",
+                              VIEWER_CLOSE_WAIT)
+
+    @property
+    def had_viewer(self) -> bool:
+        """Whether a viewer window was opened (its threads may outlive the loop)."""
+        return self._viewer_opened
 
     def _publish_current(self) -> None:
         """The state now, when stepping skipped it: read, stamped on /clock, its wrench and joint states."""
@@ -597,4 +612,9 @@ def main(argv: list[str] | None = None) -> int:
     if not stop_early:
         node.run()
     rospy.signal_shutdown("stopped")
+    if node.had_viewer:
+        # The viewer's daemon threads sit in GLFW/OpenGL: the interpreter's exit could wait on them (a
+        # roslaunch shutdown once hung until killed). The state is published and the logs are flushed.
+        logging.shutdown()
+        os._exit(0)
     return 0
