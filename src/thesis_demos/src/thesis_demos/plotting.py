@@ -64,7 +64,12 @@ def _plot_teach(scenario: Scenario, rec: Recording, verdict: Verdict, path: str)
     ax_f.set_ylabel("contact force Z [N]")
     for ax in (ax_d, ax_f):
         ax.set_xlabel("time since the path started [s]")
-    for ax in (ax_xy, ax_d, ax_f):
+    _finish(fig, (ax_xy, ax_d, ax_f), scenario, verdict, path)
+
+
+def _finish(fig, axes, scenario: Scenario, verdict: Verdict, path: str) -> None:
+    """Grids and legends, the verdict as the title, the PNG written and the figure freed."""
+    for ax in axes:
         ax.grid(True, alpha=0.3)
         ax.legend(loc="upper right", fontsize=8)
     fig.suptitle(f"{scenario.title}\n{'PASS' if verdict.passed else 'FAIL'}: {verdict.summary}", fontsize=8,
@@ -138,11 +143,4 @@ def plot_task(scenario: Scenario, rec: TaskRecording, verdict: Verdict, path: st
     ax_f.set_ylabel("|F| [N] (dashed: the limit)")
     ax_d.set_ylabel("depth past the touch [mm]")
     ax_d.set_xlabel("time since the task began [s]")
-    for ax in (ax_xy, ax_f, ax_d):
-        ax.grid(True, alpha=0.3)
-        ax.legend(loc="upper right", fontsize=8)
-    fig.suptitle(f"{scenario.title}\n{'PASS' if verdict.passed else 'FAIL'}: {verdict.summary}", fontsize=8,
-                 wrap=True)
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    _finish(fig, (ax_xy, ax_f, ax_d), scenario, verdict, path)
