@@ -63,3 +63,18 @@ def test_the_seeded_offset_is_within_its_spread_and_the_same_for_the_same_seed()
 def test_a_tilted_block_is_refused():
     with pytest.raises(ValueError, match="level obstacle"):
         hole_boxes(Box(position=(0.0, 0.0, 0.0), size=(0.1, 0.1, 0.1), rpy=(0.1, 0.0, 0.0)), HOLE)
+
+
+def test_the_tilted_fixture_turns_the_block_about_y_and_needs_a_block():
+    from mujoco_driver.params import DriverParamError, DriverSettings, load_scene
+
+    scene = {"start_pose": [0.0], "servo": {"kp": 1.0, "kv": 1.0},
+             "obstacle": {"position": [0.5, 0.0, 0.05], "size": [0.1, 0.1, 0.1], "rpy": [0.0, 0.1, 0.2]}}
+    cfg = load_scene(DriverSettings.from_params({"fixture": "tilted", "scene": scene}))
+    assert cfg.obstacle is not None
+    assert cfg.obstacle.rpy == pytest.approx((0.0, 0.1 + math.radians(15.0), 0.2), abs=1e-4)
+    cfg = load_scene(DriverSettings.from_params({"fixture": "tilted", "surface_tilt": 0.3, "scene": scene}))
+    assert cfg.obstacle is not None and cfg.obstacle.rpy[1] == pytest.approx(0.4)
+    del scene["obstacle"]
+    with pytest.raises(DriverParamError, match="no obstacle block to tilt"):
+        load_scene(DriverSettings.from_params({"fixture": "tilted", "scene": scene}))

@@ -32,6 +32,7 @@ __all__ = [
     "LAW_FORCE_TRACKING",
     "LAW_NAMES",
     "LAW_NONE",
+    "LAW_NORMAL",
     "LAW_PATH",
     "LAW_SPRING",
     "LINEAR_AXES",
@@ -65,6 +66,7 @@ class Law(IntEnum):
     COMPLIANT_MOVE = 3
     FORCE_TRACKING = 4  # AxisLaw FORCE_TRACKING: through ConfigureLaws only (ControlLaw stops at 3)
     PATH = 5  # AxisLaw PATH: follows ~path_reference (a replay), ConfigureLaws only
+    NORMAL = 6  # AxisLaw NORMAL: RX/RY turn the tool's axis onto the contact normal, ConfigureLaws only
 
 
 class End(IntEnum):
@@ -108,6 +110,7 @@ LAW_NAMES: dict[int, str] = {
     Law.COMPLIANT_MOVE: "compliant_move",
     Law.FORCE_TRACKING: "force_tracking",
     Law.PATH: "path",
+    Law.NORMAL: "normal",
 }
 END_NAMES: dict[int, str] = {
     End.NONE: "none",
@@ -135,7 +138,7 @@ SAFETY_NAMES: dict[int, str] = {
 }
 
 # The members under their message constant names, as the rest of the stack uses them.
-LAW_NONE, LAW_FOLLOWER, LAW_SPRING, LAW_COMPLIANT_MOVE, LAW_FORCE_TRACKING, LAW_PATH = Law
+LAW_NONE, LAW_FOLLOWER, LAW_SPRING, LAW_COMPLIANT_MOVE, LAW_FORCE_TRACKING, LAW_PATH, LAW_NORMAL = Law
 (END_NONE, END_FT_VIOLATION, END_MAX_TRAVEL, END_DIFF_VIOLATION, END_NO_FT_DATA, END_EXTERNAL_STOP,
  END_OSCILLATION, END_PATH_LOST, END_PATH_ERROR) = End
 EXCEEDED_STOP, EXCEEDED_MOVE_AWAY, EXCEEDED_GRAVITY_COMPENSATION = Exceeded

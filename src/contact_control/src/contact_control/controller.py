@@ -21,6 +21,7 @@ from contact_control.law_set import LawSet
 from contact_control.laws import AxisLaw, guard_pressing, law_velocity, path_velocity, shape_velocity
 from contact_control.loop_gain import GainBound
 from contact_control.move import MoveState
+from contact_control.normal import NormalFollower, normal_velocity
 from contact_control.oscillation import OscillationGuard
 from contact_control.params import ContactControlSettings
 from contact_control.path_ref import PathReference
@@ -52,13 +53,11 @@ class ContactControl:
                                int(s.force_limit_samples))
         self._moved = MoveTravel(s.travel_directions)
         self._reaction = ExceededReaction(self._tuning, s.move_away_release_fraction)
-        self._set = LawSet()
-        self._shown = list(self._set.types)  # the law each axis runs now (gravity compensation: follower)
+        self._set, self._shown = LawSet(), [int(Law.NONE)] * 6  # _shown: what runs now (a follower, reacting)
         self._path = PathReference(s.path_reference_timeout, s.path_extrapolate)
-        self._path_error = [0.0] * 6
-        self._path_velocity = [0.0] * 6
-        self._v = [0.0] * 6
-        self._wrench = [0.0] * 6
+        self._path_error, self._path_velocity = [0.0] * 6, [0.0] * 6
+        self._normal = NormalFollower(s.normal_min_force, s.normal_max_rate, s.normal_jump, s.normal_friction)
+        self._v, self._wrench = [0.0] * 6, [0.0] * 6
         self._move = MoveState()
         self._last_t: float | None = None
         self._gain_bound = GainBound(s.loop_gain_delay, s.command_latency, s.spring_output_scale,
@@ -116,11 +115,8 @@ class ContactControl:
         """Starts a move with six validated laws (x, y, z, rx, ry, rz; `request.validate_request`), replacing
         any running move at once, and returns its id. `eef_pose`: the 4x4 EEF pose in the fixed frame at the
         start (None: the next `update`'s); `t`: now [s] (for the no-data end timeout); `R_fixed_control`: the
-        control frame's orientation at the start (None: the fixed frame's).
-
-        Raises RequestError (the global safety is latched: reset first) or ValueError (not six AxisLaw);
-        either way nothing changes.
-        """
+        control frame's orientation at the start (None: the fixed frame's). Raises RequestError (the global
+        safety is latched: reset first) or ValueError (not six AxisLaw); either way nothing changes."""
         laws = list(laws)
         if len(laws) != 6 or not all(isinstance(law, AxisLaw) for law in laws):
             raise ValueError("set_laws needs six AxisLaw (x, y, z, rx, ry, rz)")
@@ -143,6 +139,7 @@ class ContactControl:
         self._adopt(laws)
         self._ends.restart(t)
         self._v = [0.0] * 6
+        self._normal.reset()
         self._moved.restart(eef_pose, R_fixed_control)
         self._last_t = None
         return self._move.begin(bool(self._set.active), t)
@@ -235,12 +232,12 @@ class ContactControl:
         ended = self._check_ends(t, w, eef_pose, R_fixed_control)
         if ended is not None:
             return ended
-        self._step_velocities(t, w)
+        self._step_velocities(t, w, T_control_sensor, R_fixed_control)
         stopped = self._watch_oscillation(t)
         if stopped is not None:
             return stopped
         self._ends.arm(t)
-        return self._result(t, Safety.OK, "")
+        return self._result(t, Safety.OK, self._normal.message if self._set.normal_axes else "")
 
     def _accept(self, wrench: Sequence[float], t: float, stamp: float | None, T_control_sensor: Matrix | None,
                 R_world_sensor: Matrix | None) -> list[float] | CycleResult:
@@ -272,14 +269,17 @@ class ContactControl:
             axis, end = self._ends.check(t, self._set, w, self._moved.values)
         return self._end_and_hold(t, axis, end) if end else None
 
-    def _step_velocities(self, t: float, w: list[float]) -> None:
+    def _step_velocities(self, t: float, w: list[float], T_cs: Matrix | None, R_fc: Matrix | None) -> None:
         """Each active axis's law, then its velocity shaped by the rate limits over the cycle's dt."""
         dt = self._cycle_dt(t)
         c, v, tuning, travel = self._set, self._v, self._tuning, self._moved.values
         error, reference, fast = self._path_error, self._path_velocity, self.preprocessor.fast
+        turn = self._normal.control_step(w, v, dt, T_cs, R_fc) if c.normal_axes else None
         for i in c.active:
             if c.is_path[i]:
                 target = path_velocity(c.laws[i], tuning[i], w[i], error[i], reference[i])
+            elif turn is not None and i in c.normal_axes:
+                target = normal_velocity(c.laws[i], turn[i - 3])
             else:
                 target = law_velocity(c.laws[i], tuning[i], w[i], travel[i])
                 if c.guarded[i]:
@@ -325,8 +325,8 @@ class ContactControl:
         return self._hold(t, Safety.STALE, f"{age} (wrench_timeout {timeout} s)")
 
     def hold(self, t: float, safety: int, message: str, received: bool = True) -> CycleResult:
-        """Zero output for a reason found outside (e.g. SAFETY_NO_TF); the move resumes on the next update.
-        `received`: a wrench did arrive at `t` (so the stale check does not also fire)."""
+        """Zero output for a reason found outside (SAFETY_NO_TF); the move resumes on the next update.
+        `received`: a wrench came at `t` (so the stale check does not also fire)."""
         if received:
             self.intake.last_wrench_time = t
         return self._hold(t, safety, message)

@@ -6,12 +6,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
-from contact_control.axes import LAW_FOLLOWER, LAW_FORCE_TRACKING, LAW_NONE, LAW_PATH
+from contact_control.axes import LAW_FOLLOWER, LAW_FORCE_TRACKING, LAW_NONE, LAW_NORMAL, LAW_PATH
 from contact_control.laws import AxisLaw
 
 __all__ = ["LawSet"]
 
-_NO_TRAVEL = (LAW_FOLLOWER, LAW_FORCE_TRACKING)  # laws that need no travel unless they have a max travel
+_NO_TRAVEL = (LAW_FOLLOWER, LAW_FORCE_TRACKING, LAW_NORMAL)  # no travel needed unless they have a max travel
 
 
 @dataclass(frozen=True)
@@ -30,6 +30,7 @@ class LawSet:
         is_path: per axis, the path law.
         path_axes: the active axes on a path.
         watched: the active axes the oscillation watchdog watches (a path may turn on purpose).
+        normal_axes: the active axes on the normal law (rx, ry).
     """
 
     laws: tuple[AxisLaw, ...] = (AxisLaw(),) * 6
@@ -43,6 +44,7 @@ class LawSet:
     is_path: tuple[bool, ...] = (False,) * 6
     path_axes: tuple[int, ...] = ()
     watched: tuple[int, ...] = ()
+    normal_axes: tuple[int, ...] = ()
 
     @classmethod
     def of(cls, laws: Sequence[AxisLaw], diff_max: Sequence[float], fast_guard: bool) -> LawSet:
@@ -58,11 +60,12 @@ class LawSet:
             active=active,
             diff_axes=tuple(i for i in active if diff_max[i] > 0.0),
             needs_travel=any(law.law not in _NO_TRAVEL or law.max_travel > 0.0 for law in laws if law.law),
-            floor=tuple(law.law not in (LAW_FORCE_TRACKING, LAW_PATH) for law in laws),
+            floor=tuple(law.law not in (LAW_FORCE_TRACKING, LAW_PATH, LAW_NORMAL) for law in laws),
             guarded=tuple(fast_guard and law.law == LAW_FORCE_TRACKING and law.target != 0.0 for law in laws),
             is_path=is_path,
             path_axes=tuple(i for i in active if is_path[i]),
             watched=tuple(i for i in active if not is_path[i]),
+            normal_axes=tuple(i for i in active if laws[i].law == LAW_NORMAL),
         )
 
     def with_law(self, axis: int, law: AxisLaw) -> LawSet:

@@ -20,6 +20,8 @@ the law was set [m] ([rad]), V the commanded velocity [m/s] ([rad/s]):
 - path: V = v_ref + k e (+ F / b when b > 0, outside the follower's deadband), e the pose error to a reference
   that moves (a replay streams it, `path_ref.PathReference`): a spring whose anchor travels along the path,
   with the path's velocity fed forward. `max_travel` bounds |e| (PATH_ERROR).
+- normal (RX/RY): W = k theta, theta the turn that brings the tool's axis onto the contact normal estimated
+  from the force (`normal.NormalFollower`, `normal.normal_velocity`); at most `velocity` when > 0.
 - none: V = 0.
 
 `shape_velocity` then zeroes |V| <= min_velocity, clamps to the max velocity and limits acceleration and

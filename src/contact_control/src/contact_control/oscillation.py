@@ -15,6 +15,7 @@ from contact_control.axes import (
     LAW_FOLLOWER,
     LAW_FORCE_TRACKING,
     LAW_NONE,
+    LAW_NORMAL,
     LAW_SPRING,
 )
 from contact_control.laws import AxisLaw
@@ -64,6 +65,8 @@ def halved(law: AxisLaw) -> AxisLaw | None:
         return replace(law, damping=2.0 * law.damping)
     if law.law == LAW_SPRING:
         return replace(law, damping=2.0 * law.damping, stiffness=0.5 * law.stiffness)
+    if law.law == LAW_NORMAL:  # its gain is k alone
+        return replace(law, stiffness=0.5 * law.stiffness)
     return None
 
 
@@ -116,6 +119,8 @@ class OscillationGuard:
                 seen.append((i, None, f"{what}: stopped, the gain was already lowered"))
                 break
             self._halved[i] = True
-            k = f", k {law.stiffness:g} -> {lower.stiffness:g}" if law.law == LAW_SPRING else ""
-            seen.append((i, lower, f"{what}: gain halved (b {law.damping:g} -> {lower.damping:g}{k})"))
+            k = f"k {law.stiffness:g} -> {lower.stiffness:g}"
+            gains = (k if law.law == LAW_NORMAL else f"b {law.damping:g} -> {lower.damping:g}"
+                     + (f", {k}" if law.law == LAW_SPRING else ""))
+            seen.append((i, lower, f"{what}: gain halved ({gains})"))
         return seen

@@ -279,6 +279,23 @@ class ContactControlSettings:
         True, doc="force tracking never presses faster than (F_target - F) / b with F unfiltered once that F "
         "is in contact: a touch stops the pressing before the low-pass filter has seen it",
     )
+    # normal law (ConfigureLaws NORMAL on RX/RY; README, Keeping the tool normal)
+    normal_min_force: float = _pos(
+        3.0, "N", "the normal law reads the contact normal from |F| at or above this; below it the tool's "
+        "orientation holds (no contact to read; a guess: `event_touch_force`'s value)"
+    )
+    normal_max_rate: float = _pos(
+        0.15, "rad/s", "the followed normal turns at most this fast (a 0.25 m cylinder passed at 20 mm/s "
+        "turns it 0.08 rad/s)"
+    )
+    normal_jump: float = _pos(
+        0.2, "rad", "a normal estimate this far from the followed one (an edge, a landing elsewhere) is not "
+        "followed: the orientation holds and ~status says so"
+    )
+    normal_friction: float = _nonneg(
+        0.0, "", "the tool-surface sliding friction coefficient: the friction it predicts (mu |F| against "
+        "the slide) is taken out of the force before the normal is read; 0: none assumed"
+    )
     # path law (ConfigureLaws PATH, fed by ~path_reference)
     path_reference_timeout: float = _pos(
         0.5, "s", "a path law's move ends (PATH_LOST) when no ~path_reference came for this long (the tool "

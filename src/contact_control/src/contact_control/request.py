@@ -38,6 +38,7 @@ from contact_control.axes import (
     LAW_FORCE_TRACKING,
     LAW_NAMES,
     LAW_NONE,
+    LAW_NORMAL,
     LAW_PATH,
     LAW_SPRING,
 )
@@ -354,6 +355,19 @@ def _compliant_move(a: _Axis) -> AxisLaw:
     return a.law_with(LAW_COMPLIANT_MOVE, damping=b, velocity=v)
 
 
+def _normal(a: _Axis) -> AxisLaw:
+    """W = k theta on RX/RY: the tool's axis turned onto the contact normal (normal.NormalFollower)."""
+    a.require(a.name in ("rx", "ry"), SET_DOF_FAILED,
+              "the normal law turns the tool's axis about RX and RY only", "law")
+    k = a.gain("normal gain k")
+    a.require(a.v >= 0.0 and math.isfinite(a.v), SET_CARTESIAN_CONTROL_FAILED,
+              f"turning speed cap must be finite, >= 0 {a.unit_v} (0: only the node's clamp)", "v")
+    vmax = a.limits.max_angular_velocity
+    a.require(vmax is None or a.v <= vmax, SET_CARTESIAN_CONTROL_FAILED,
+              f"turning speed cap exceeds max velocity {vmax} {a.unit_v}", "v")
+    return a.law_with(LAW_NORMAL, stiffness=k, velocity=a.v)
+
+
 #: What each law checks and builds (LAW_NONE needs nothing).
 _LAWS: dict[int, Callable[[_Axis], AxisLaw]] = {
     LAW_FOLLOWER: _follower,
@@ -361,11 +375,13 @@ _LAWS: dict[int, Callable[[_Axis], AxisLaw]] = {
     LAW_COMPLIANT_MOVE: _compliant_move,
     LAW_FORCE_TRACKING: _force_tracking,
     LAW_PATH: _path,
+    LAW_NORMAL: _normal,
 }
 _LAWS_REQUEST_ONLY: dict[int, str] = {
     LAW_PATH: "the path law (5) is offered through compliant_control_msgs/ConfigureLaws only",
     LAW_FORCE_TRACKING: "force tracking (4) is offered through compliant_control_msgs/ConfigureLaws only "
                         "(service configure_laws, field target_force)",
+    LAW_NORMAL: "the normal law (6) is offered through compliant_control_msgs/ConfigureLaws only",
 }
 
 
@@ -386,7 +402,7 @@ def _axis_law(
     if target is None and a.law in _LAWS_REQUEST_ONLY:
         raise a.fail(SET_DOF_FAILED, _LAWS_REQUEST_ONLY[a.law], "law")
     if a.law not in LAW_NAMES:
-        known = "0 none, 1 follower, 2 spring, 3 compliant move" + (", 4 force tracking, 5 path"
+        known = "0 none, 1 follower, 2 spring, 3 compliant move" + (", 4 force tracking, 5 path, 6 normal"
                                                                      if target is not None else "")
         raise a.fail(SET_DOF_FAILED, f"unknown law type {a.law} ({known})", "law")
     if a.law == LAW_NONE:

@@ -36,7 +36,7 @@ AXIS_NAMES = ("x", "y", "z", "rx", "ry", "rz")
 #: What ends a step (see `Exit`).
 EXIT_KINDS = ("touch", "release", "move_ended", "force", "travel", "depth", "timeout", "pattern_done")
 PATTERN_KINDS = ("none", "line", "spiral", "lissajous", "wiggle")
-_LAW_KINDS = ("none", "follower", "spring", "compliant_move", "force_tracking", "path")
+_LAW_KINDS = ("none", "follower", "spring", "compliant_move", "force_tracking", "path", "normal")
 _ACTIONS = ("stop", "move_away", "gravity_compensation")
 _SIGNED_AXES = (*AXIS_NAMES, *(f"-{a}" for a in AXIS_NAMES[:3]))
 
@@ -51,9 +51,10 @@ class Law:
 
     law: str = param("none", choices=_LAW_KINDS, doc="the law (AxisLaw's constants in lower case)")
     damping: float = param(0.0, unit="N/(m/s), Nm/(rad/s)", ge=0.0, doc="b")
-    stiffness: float = param(0.0, unit="1/s", ge=0.0, doc="k of the spring; the path law's gain on its error")
+    stiffness: float = param(0.0, unit="1/s", ge=0.0, doc="k of the spring; the path law's gain on its "
+                             "error; the normal law's on its angle")
     velocity: float = param(0.0, unit="m/s, rad/s", doc="a compliant move's V_desired (signed); force "
-                            "tracking's approach speed; a follower's speed cap")
+                            "tracking's approach speed; a follower's or the normal law's speed cap")
     force_limit: float = param(0.0, unit="N, Nm", doc="|F| that ends the step's move (0: none; its sign "
                                "gives a compliant move's direction when velocity is 0)")
     max_travel: float = param(0.0, unit="m, rad", ge=0.0, doc="|d| that ends the step's move (0: none); the "

@@ -77,9 +77,13 @@ class DriverSettings:
         0.01, unit="s", ge=0.0, doc="period of `~eef_pose` (ground truth for plots); 0 = with `joint_states`"
     )
     fixture: str = param(
-        "none", choices=("none", "hole", "hand"),
+        "none", choices=("none", "hole", "hand", "tilted"),
         doc="hole: a plate with a square, chamfered hole on the obstacle block, for a square peg tool; hand: "
-        "a person's hand (ISO/TS 15066: 0.6 kg, 75 N/mm) lying on the block (README, Fixtures)",
+        "a person's hand (ISO/TS 15066: 0.6 kg, 75 N/mm) lying on the block; tilted: the block turned by "
+        "`surface_tilt` about the base's y axis, a sloping top (README, Fixtures)",
+    )
+    surface_tilt: float = param(
+        0.2618, unit="rad", gt=0.0, le=0.7, doc="with `fixture` tilted: the block's turn about y (15 degrees)"
     )
     hole_offset: tuple[float, ...] = param(
         (0.0, 0.0, 0.0), type="floats", length=3, unit="m, m, rad",
@@ -253,6 +257,12 @@ def load_scene(settings: DriverSettings) -> SceneConfig:
         hole = Hole(peg=settings.peg_width, clearance=settings.hole_clearance, depth=settings.hole_depth,
                     chamfer=settings.hole_chamfer, offset=offset)  # type: ignore[arg-type]
         cfg = dataclasses.replace(cfg, hole=hole)
+    if settings.fixture == "tilted":
+        if cfg.obstacle is None:
+            raise DriverParamError("~fixture tilted: the scene has no obstacle block to tilt")
+        roll, pitch, yaw = cfg.obstacle.rpy
+        cfg = dataclasses.replace(cfg, obstacle=dataclasses.replace(
+            cfg.obstacle, rpy=(roll, pitch + settings.surface_tilt, yaw)))
     if settings.fixture == "hand":
         if cfg.obstacle is None:
             raise DriverParamError("~fixture hand: the scene has no obstacle block to lay the hand on")
