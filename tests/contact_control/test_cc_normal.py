@@ -13,6 +13,7 @@ from cc_sim import DT, ClosedLoop, controller, laws, rot
 from contact_control.axes import LAW_FORCE_TRACKING, LAW_NORMAL, SAFETY_OK
 from contact_control.laws import AxisLaw
 from contact_control.normal import NormalFollower, normal_velocity
+from contact_control.params import load_settings
 from contact_control.request import (
     SET_CARTESIAN_CONTROL_FAILED,
     SET_DOF_FAILED,
@@ -140,12 +141,14 @@ def test_a_slowly_turning_normal_is_followed_at_the_rate_limit():
 @pytest.mark.parametrize("mu", [0.3])
 def test_friction_while_sliding_tilts_the_estimate_unless_its_coefficient_is_given(mu):
     """Sliding along X across a plane tilted about X: friction leans the force back by atan(mu), and the
-    tool with it, unless normal_friction takes it out."""
+    tool with it, unless normal_friction (tuned live) takes it out."""
     normal = np.array([0.0, -math.sin(TILT), math.cos(TILT)])
     slide = AxisLaw(3, damping=0.0, velocity=0.01, max_travel=0.05)  # compliant move along X
     errors = {}
     for given in (0.0, mu):
-        loop = tool_loop(normal_friction=given)
+        loop = tool_loop()
+        if given:  # tuned live, as `dynparam set` does
+            loop.ctrl.retune(load_settings({"tare_on_startup": False, "normal_friction": given}))
         loop.start(laws(x=slide, z=PRESS, rx=NORMAL, ry=NORMAL))
         loop.run(Plane(normal, mu=mu), 4.0)
         errors[given] = math.degrees(math.atan2(loop.pose[0, 2], -loop.pose[2, 2]))  # lean about Y

@@ -76,5 +76,52 @@ def test_the_tilted_fixture_turns_the_block_about_y_and_needs_a_block():
     cfg = load_scene(DriverSettings.from_params({"fixture": "tilted", "surface_tilt": 0.3, "scene": scene}))
     assert cfg.obstacle is not None and cfg.obstacle.rpy[1] == pytest.approx(0.4)
     del scene["obstacle"]
-    with pytest.raises(DriverParamError, match="no obstacle block to tilt"):
+    with pytest.raises(DriverParamError, match="no obstacle block to stand for the part"):
         load_scene(DriverSettings.from_params({"fixture": "tilted", "scene": scene}))
+
+
+def _height(kind: str, x: float, y: float, **params) -> float:
+    """The surface's height [m] under (x, y): a ray cast down onto the scene `load_scene` makes with the
+    `kind` fixture on a 0.15 x 0.15 x 0.13 block centred at (0.6, 0.1)."""
+    import numpy as np
+    from mujoco_driver.params import DriverSettings, load_scene
+    from mujoco_driver.scene import _add_environment
+
+    scene = {"start_pose": [0.0], "servo": {"kp": 1.0, "kv": 1.0},
+             "obstacle": {"position": [0.6, 0.1, 0.065], "size": [0.15, 0.15, 0.13]}}
+    cfg = load_scene(DriverSettings.from_params({"fixture": kind, "scene": scene, **params}))
+    spec = mujoco.MjSpec()
+    _add_environment(spec, cfg)
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    geom = np.array([-1], dtype=np.int32)
+    down = np.array([0.0, 0.0, -1.0])
+    distance = mujoco.mj_ray(model, data, np.array([x, y, 1.0]), down, None, 1, -1, geom)
+    assert model.geom(geom[0]).name == "obstacle"
+    return 1.0 - distance
+
+
+@pytest.mark.parametrize(("kind", "radius"), [("cylinder", 0.25), ("sphere", 0.3)])
+def test_a_curved_part_stands_in_the_blocks_place_moved_by_its_offset(kind, radius):
+    offset = (0.004, -0.003, 0.002)
+    args = {"surface_offset": list(offset)}
+    top = (0.6 + offset[0], 0.1 + offset[1], 0.13 + offset[2])
+    assert _height(kind, top[0], top[1], **args) == pytest.approx(top[2], abs=1e-6)
+    # 60 mm along x the surface has fallen as a circle of the radius says; along y only the sphere's has
+    fallen = radius - math.sqrt(radius**2 - 0.06**2)
+    assert _height(kind, top[0] + 0.06, top[1], **args) == pytest.approx(top[2] - fallen, abs=1e-6)
+    across = _height(kind, top[0], top[1] + 0.06, **args)
+    assert across == pytest.approx(top[2] - (fallen if kind == "sphere" else 0.0), abs=1e-6)
+
+
+def test_a_seeded_surface_is_off_by_up_to_10_mm_the_same_way_for_the_same_seed():
+    from mujoco_driver.params import DriverSettings, load_scene
+
+    scene = {"start_pose": [0.0], "servo": {"kp": 1.0, "kv": 1.0},
+             "obstacle": {"position": [0.6, 0.1, 0.065], "size": [0.15, 0.15, 0.13]}}
+    offsets = [load_scene(DriverSettings.from_params({"fixture": "cylinder", "surface_seed": seed,
+                                                      "scene": scene})).surface.offset for seed in (1, 2, 1)]
+    assert offsets[0] == offsets[2] != offsets[1]
+    assert all(0.0 < abs(d) <= 0.01 for offset in offsets for d in offset)
+    assert _height("sphere", 0.6, 0.1, surface_seed=1) != pytest.approx(0.13, abs=1e-4)

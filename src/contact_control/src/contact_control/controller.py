@@ -56,7 +56,7 @@ class ContactControl:
         self._set, self._shown = LawSet(), [int(Law.NONE)] * 6  # _shown: what runs now (a follower, reacting)
         self._path = PathReference(s.path_reference_timeout, s.path_extrapolate)
         self._path_error, self._path_velocity = [0.0] * 6, [0.0] * 6
-        self._normal = NormalFollower(s.normal_min_force, s.normal_max_rate, s.normal_jump, s.normal_friction)
+        self._normal = NormalFollower.of(s)
         self._v, self._wrench = [0.0] * 6, [0.0] * 6
         self._move = MoveState()
         self._last_t: float | None = None
@@ -207,6 +207,7 @@ class ContactControl:
         self._tuning = tuple(s.tuning(i >= 3) for i in range(6))
         self._ends.diff = tuple(t.diff_max for t in self._tuning)
         self._reaction.retune(self._tuning)
+        self._normal.tune(s)
         self._watch_floor_update()
         return self.intake.retune(s)
 
@@ -217,9 +218,8 @@ class ContactControl:
         """One control cycle for a received wrench (fx, fy, fz, tx, ty, tz) [N, Nm] in the sensor frame,
         received at `t` [s] (every call's clock), stamped `stamp` [s] (None: not stamped; older than
         wrench_timeout counts as no data). Poses: the sensor in the control frame (4x4; None: the same
-        frame), the sensor's orientation in the fixed frame (3x3, for tool gravity), the EEF in the fixed
-        frame (4x4, for travel; None: not updated) and the control frame's orientation at the move's start,
-        used if the start is taken now."""
+        frame), the sensor's orientation in the fixed frame (3x3, tool gravity), the EEF in the fixed frame
+        (4x4, travel; None: not updated), the control frame's orientation in the fixed frame (None: same)."""
         w = self._accept(wrench, t, stamp, T_control_sensor, R_world_sensor)
         if isinstance(w, CycleResult):
             return w

@@ -16,6 +16,7 @@ import math
 from collections.abc import Sequence
 
 from contact_control.laws import AxisLaw
+from contact_control.params import ContactControlSettings
 from contact_control.preprocess import Matrix
 
 __all__ = ["NormalFollower", "Vec3", "normal_velocity"]
@@ -26,6 +27,9 @@ _ZERO: Vec3 = (0.0, 0.0, 0.0)
 # wrench's 5 Hz low-pass alone takes ~0.1 s to settle after a touch).
 SETTLE_ANGLE = 0.035  # [rad], 2 degrees
 SETTLE_TIME = 0.2  # [s]
+# The sliding speed from which friction is taken as fully developed (a guess); slower, in proportion: a
+# press along a turned tool's axis moves it across the axis by a hair, which is no slide.
+SLIP_SPEED = 0.002  # [m/s]
 
 
 def _dot(a: Sequence[float], b: Sequence[float]) -> float:
@@ -67,12 +71,23 @@ class NormalFollower:
         friction: the sliding friction coefficient mu between tool and surface (0: none assumed).
     """
 
-    def __init__(self, min_force: float, max_rate: float, jump: float, friction: float) -> None:
+    def __init__(self, min_force: float = 3.0, max_rate: float = 0.15, jump: float = 0.2,
+                 friction: float = 0.0) -> None:
         self.min_force, self.max_rate, self.jump, self.friction = min_force, max_rate, jump, friction
         self._normal: Vec3 | None = None
         self._candidate: Vec3 | None = None
         self._steady = 0.0
         self.message = ""
+
+    @classmethod
+    def of(cls, s: ContactControlSettings) -> NormalFollower:
+        """One with the node's `normal_*` settings."""
+        return cls(s.normal_min_force, s.normal_max_rate, s.normal_jump, s.normal_friction)
+
+    def tune(self, s: ContactControlSettings) -> None:
+        """The node's `normal_*` settings, changed live; the followed normal stays."""
+        self.min_force, self.max_rate, self.jump, self.friction = (
+            s.normal_min_force, s.normal_max_rate, s.normal_jump, s.normal_friction)
 
     def reset(self) -> None:
         """A new move: the normal is read afresh once the contact has settled."""
@@ -105,9 +120,10 @@ class NormalFollower:
             return None
         if self.friction > 0.0:
             along = _dot(velocity, axis)
-            slide = _unit([velocity[i] - along * axis[i] for i in range(3)])
-            if slide is not None:  # friction pushed back against the slide: add it back
-                mu_n = self.friction * abs(_dot(force, axis))
+            slide = [velocity[i] - along * axis[i] for i in range(3)]
+            speed = math.sqrt(_dot(slide, slide))
+            if speed > 0.0:  # friction pushed back against the slide: add it back, full once it slides
+                mu_n = self.friction * abs(_dot(force, axis)) * min(speed, SLIP_SPEED) / (SLIP_SPEED * speed)
                 force = [force[i] + mu_n * slide[i] for i in range(3)]
         return _unit(force)
 
@@ -166,10 +182,9 @@ def _times(R: Matrix, v: Sequence[float]) -> Vec3:
 
 def normal_velocity(law: AxisLaw, angle: float) -> float:
     """The normal law's angular velocity before shaping: W = k theta, theta this axis's part of the turn onto
-    the contact normal (`NormalFollower`), at most the law's turning speed cap when that is > 0."""
+    the contact normal (`NormalFollower`); at most `velocity` when that is > 0."""
     w = law.stiffness * angle
     cap = law.velocity
     if cap > 0.0 and not -cap <= w <= cap:
         return cap if w > 0.0 else -cap
     return w
-

@@ -27,6 +27,7 @@ __all__ = [
     "PerJoint",
     "SceneConfig",
     "ServoConfig",
+    "Surface",
     "TableConfig",
     "load_scene_config",
 ]
@@ -176,6 +177,19 @@ class Hand:
 
 
 @dataclass(frozen=True)
+class Surface:
+    """The part a finishing task works on (README, Fixtures): `plane` is the obstacle block itself (tilted by
+    the driver's `surface_tilt`); `cylinder` (axis along the base's y) and `sphere` replace the block, their
+    top at its top centre moved by `offset` (dx, dy, dz [m]), which a task is not told. Its sliding friction
+    with the tool is `friction` (it outranks the tool's: MuJoCo geom priority)."""
+
+    kind: str = "plane"
+    radius: float = 0.0  # [m] cylinder and sphere
+    offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    friction: float = 0.3  # a guess: a polishing pad on metal
+
+
+@dataclass(frozen=True)
 class ServoConfig:
     """Joint position servos (PD with velocity feed-forward, like an industrial joint controller).
 
@@ -226,6 +240,7 @@ class SceneConfig:
     held_joints: Mapping[str, float] = field(default_factory=dict)
     hole: Hole | None = None
     hand: Hand | None = None
+    surface: Surface | None = None
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> SceneConfig:

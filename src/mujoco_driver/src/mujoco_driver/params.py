@@ -12,10 +12,11 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
 from compliant_common.errors import StackError
 from compliant_common.schema import Param, SchemaError, param, schema_of
 
-from mujoco_driver.config import Hand, Hole, PerJoint, SceneConfig, load_scene_config
+from mujoco_driver.config import Hand, Hole, PerJoint, SceneConfig, Surface, load_scene_config
 from mujoco_driver.fixtures import hole_offset
 
 __all__ = ["PARAMETERS", "DriverParamError", "DriverSettings", "load_scene", "urdf_root_link"]
@@ -77,13 +78,31 @@ class DriverSettings:
         0.01, unit="s", ge=0.0, doc="period of `~eef_pose` (ground truth for plots); 0 = with `joint_states`"
     )
     fixture: str = param(
-        "none", choices=("none", "hole", "hand", "tilted"),
+        "none", choices=("none", "hole", "hand", "tilted", "cylinder", "sphere"),
         doc="hole: a plate with a square, chamfered hole on the obstacle block, for a square peg tool; hand: "
         "a person's hand (ISO/TS 15066: 0.6 kg, 75 N/mm) lying on the block; tilted: the block turned by "
-        "`surface_tilt` about the base's y axis, a sloping top (README, Fixtures)",
+        "`surface_tilt` about the base's y axis, a sloping top; cylinder (axis along y), sphere: a curved "
+        "part in the block's place, its top at the block's top centre (README, Fixtures)",
     )
     surface_tilt: float = param(
         0.2618, unit="rad", gt=0.0, le=0.7, doc="with `fixture` tilted: the block's turn about y (15 degrees)"
+    )
+    surface_radius: float = param(
+        0.0, unit="m", ge=0.0, le=2.0,
+        doc="the cylinder's or sphere's radius; 0: the fixture's own (cylinder 0.25 m, sphere 0.3 m)"
+    )
+    surface_offset: tuple[float, ...] = param(
+        (0.0, 0.0, 0.0), type="floats", length=3, unit="m",
+        doc="the curved part's (or the tilted block's) offset from its nominal place (dx, dy, dz), which a "
+        "task is not told",
+    )
+    surface_seed: int = param(
+        -1, ge=-1, doc=">= 0: the surface's offset drawn from this seed instead (each of dx, dy, dz within "
+        "10 mm)"
+    )
+    surface_friction: float = param(
+        0.3, unit="", gt=0.0, le=2.0, doc="sliding friction of the tilted, cylinder or sphere fixture with "
+        "the tool (a guess: a polishing pad on metal)"
     )
     hole_offset: tuple[float, ...] = param(
         (0.0, 0.0, 0.0), type="floats", length=3, unit="m, m, rad",
@@ -234,6 +253,32 @@ HOLE_SPREAD = 0.004  # [m]
 HOLE_YAW_SPREAD = 0.035  # [rad]
 
 
+# The finishing fixtures (#37): each kind's default radius [m] and how far its place is from nominal.
+SURFACE_RADIUS = {"tilted": 0.0, "cylinder": 0.25, "sphere": 0.3}
+SURFACE_SPREAD = 0.01  # [m] each of dx, dy, dz with surface_seed
+
+
+def _with_surface(cfg: SceneConfig, settings: DriverSettings) -> SceneConfig:
+    """The scene with the `tilted`, `cylinder` or `sphere` fixture (config.Surface)."""
+    kind = settings.fixture
+    if cfg.obstacle is None:
+        raise DriverParamError(f"~fixture {kind}: the scene has no obstacle block to stand for the part")
+    offset = tuple(settings.surface_offset)
+    if settings.surface_seed >= 0:
+        offset = tuple(float(x) for x in np.random.default_rng(settings.surface_seed).uniform(
+            -SURFACE_SPREAD, SURFACE_SPREAD, 3))
+    block = cfg.obstacle
+    if kind == "tilted":
+        roll, pitch, yaw = block.rpy
+        x, y, z = (a + b for a, b in zip(block.position, offset, strict=True))
+        block = dataclasses.replace(block, position=(x, y, z), rpy=(roll, pitch + settings.surface_tilt, yaw))
+        surface = Surface("plane", friction=settings.surface_friction)
+    else:
+        radius = settings.surface_radius or SURFACE_RADIUS[kind]
+        surface = Surface(kind, radius, offset, settings.surface_friction)  # type: ignore[arg-type]
+    return dataclasses.replace(cfg, obstacle=block, surface=surface)
+
+
 def load_scene(settings: DriverSettings) -> SceneConfig:
     """The scene settings from ``~scene_config`` or ``~scene``, with ``~start_pose`` applied.
 
@@ -257,12 +302,8 @@ def load_scene(settings: DriverSettings) -> SceneConfig:
         hole = Hole(peg=settings.peg_width, clearance=settings.hole_clearance, depth=settings.hole_depth,
                     chamfer=settings.hole_chamfer, offset=offset)  # type: ignore[arg-type]
         cfg = dataclasses.replace(cfg, hole=hole)
-    if settings.fixture == "tilted":
-        if cfg.obstacle is None:
-            raise DriverParamError("~fixture tilted: the scene has no obstacle block to tilt")
-        roll, pitch, yaw = cfg.obstacle.rpy
-        cfg = dataclasses.replace(cfg, obstacle=dataclasses.replace(
-            cfg.obstacle, rpy=(roll, pitch + settings.surface_tilt, yaw)))
+    if settings.fixture in SURFACE_RADIUS:
+        cfg = _with_surface(cfg, settings)
     if settings.fixture == "hand":
         if cfg.obstacle is None:
             raise DriverParamError("~fixture hand: the scene has no obstacle block to lay the hand on")

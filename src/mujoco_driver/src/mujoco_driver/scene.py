@@ -30,13 +30,13 @@ import numpy as np
 from compliant_common.errors import StackError
 from control_stack.description import DescriptionError, parse_robot
 
-from mujoco_driver.config import Box, Hand, SceneConfig
+from mujoco_driver.config import Box, Hand, SceneConfig, Surface
 from mujoco_driver.fixtures import hole_boxes
 from mujoco_driver.meshes import LinkGeometry, prepare_collision
 
 __all__ = [
     "SceneError", "SceneModel", "UrdfJoint", "build_scene", "mujoco_urdf", "mujoco_urdf_report",
-    "rpy_to_quat", "urdf_joints",
+    "rpy_to_quat", "surface_top", "urdf_joints",
 ]
 
 _log = logging.getLogger(__name__)
@@ -266,10 +266,16 @@ def _add_environment(spec: mujoco.MjSpec, cfg: SceneConfig) -> None:
                    size=[table.size[0] / 2, table.size[1] / 2, table.thickness / 2],
                    pos=[table.center[0], table.center[1], -table.thickness / 2], rgba=[0.6, 0.45, 0.3, 1.0])
     if cfg.obstacle is not None:
-        obs = cfg.obstacle
-        geom = world.add_geom(name="obstacle", type=mujoco.mjtGeom.mjGEOM_BOX, size=[s / 2 for s in obs.size],
-                              pos=list(obs.position), quat=rpy_to_quat(obs.rpy), rgba=[0.8, 0.2, 0.2, 1.0])
+        obs, surface = cfg.obstacle, cfg.surface
+        if surface is not None and surface.kind != "plane":
+            geom = _add_curved(world, obs, surface)
+        else:
+            geom = world.add_geom(name="obstacle", type=mujoco.mjtGeom.mjGEOM_BOX,
+                                  size=[s / 2 for s in obs.size], pos=list(obs.position),
+                                  quat=rpy_to_quat(obs.rpy), rgba=[0.8, 0.2, 0.2, 1.0])
         geom.solimp = OBSTACLE_SOLIMP
+        if surface is not None:  # its friction, not the tool's, makes the contact's
+            geom.priority, geom.friction = 1, [surface.friction, 0.005, 0.0001]
         if cfg.hole is not None:
             for box in hole_boxes(obs, cfg.hole):
                 part = world.add_geom(name=box.name, type=mujoco.mjtGeom.mjGEOM_BOX, size=list(box.half),
@@ -277,6 +283,26 @@ def _add_environment(spec: mujoco.MjSpec, cfg: SceneConfig) -> None:
                 part.solimp = OBSTACLE_SOLIMP
         if cfg.hand is not None:
             _add_hand(spec, obs, cfg.hand)
+
+
+def _add_curved(world: mujoco.MjsBody, block: Box, surface: Surface) -> mujoco.MjsGeom:
+    """The cylinder (axis along y, as long as the block is wide) or sphere in the block's place, its top at
+    the block's top centre moved by the surface's offset (config.Surface)."""
+    top = surface_top(block, surface)
+    centre = [top[0], top[1], top[2] - surface.radius]
+    if surface.kind == "cylinder":
+        return world.add_geom(name="obstacle", type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+                              size=[surface.radius, block.size[1] / 2.0, 0.0], pos=centre,
+                              quat=[math.sqrt(0.5), math.sqrt(0.5), 0.0, 0.0], rgba=[0.8, 0.2, 0.2, 1.0])
+    return world.add_geom(name="obstacle", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[surface.radius, 0.0, 0.0],
+                          pos=centre, rgba=[0.8, 0.2, 0.2, 1.0])
+
+
+def surface_top(block: Box, surface: Surface) -> tuple[float, float, float]:
+    """The curved part's highest point [m], where the block's top centre is without an offset."""
+    dx, dy, dz = surface.offset
+    x, y, z = block.position
+    return x + dx, y + dy, z + block.size[2] / 2.0 + dz
 
 
 def _add_hand(spec: mujoco.MjSpec, block: Box, hand: Hand) -> None:
