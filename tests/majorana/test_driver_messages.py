@@ -1,4 +1,5 @@
-"""controller_manager_msgs, franka_msgs and ur_dashboard_msgs (the subsets the emulated drivers serve) keep
+"""controller_manager_msgs, franka_msgs and ur_dashboard_msgs (the subsets the emulated drivers serve) and
+control_msgs (named_poses' FollowJointTrajectory server) keep
 the real packages' wire format: genmsg computes an md5sum from the definition text, so identical fields and
 constants give the md5sums that the upstream packages' generated code carries."""
 
@@ -6,6 +7,12 @@ import pytest
 
 pytest.importorskip("controller_manager_msgs.srv", reason="needs devel/setup.bash (make test sources it)")
 
+from control_msgs.msg import (
+    FollowJointTrajectoryFeedback,
+    FollowJointTrajectoryGoal,
+    FollowJointTrajectoryResult,
+    JointTolerance,
+)
 from controller_manager_msgs import msg, srv
 from franka_msgs.msg import ErrorRecoveryActionGoal, ErrorRecoveryGoal, ErrorRecoveryResult, FrankaState
 from ur_dashboard_msgs.msg import RobotMode, SafetyMode
@@ -24,6 +31,12 @@ MD5 = {
     # Universal_Robots_ROS_Driver's generated code (ur_dashboard_msgs, Noetic).
     SafetyMode: "5da08725a63d4237bad689481131a84b",
     RobotMode: "73b72d58742c4889c47118411b03a3b4",
+    # control_msgs 1.5 (Noetic), its generated code in rosserial and ROS.NET builds; the goal's md5 covers
+    # JointTolerance's too (genmsg hashes a field's type by its md5).
+    FollowJointTrajectoryGoal: "69636787b6ecbde4d61d711979bc7ecb",
+    FollowJointTrajectoryResult: "493383b18409bfb604b4e26c676401d2",
+    FollowJointTrajectoryFeedback: "10817c60c2486ef6b33e97dcd87f4474",
+    JointTolerance: "f544fe9c16cf04547e135dd6063ff5be",
 }
 
 

@@ -90,6 +90,7 @@ class ControlStackNode:
         with self._lock:
             t = rospy.get_time()
             self._publish(self.pipeline.on_wrench(wrench, msg.header.frame_id, stamp, t), t)
+            self.contact_ros.send_contact()  # ~contact_wrench, only while somebody listens (named_poses)
 
     def _on_twist(self, msg: TwistStamped) -> None:
         lin, ang = msg.twist.linear, msg.twist.angular

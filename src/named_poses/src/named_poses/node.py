@@ -35,6 +35,7 @@ from std_msgs.msg import String
 from std_srvs.srv import Trigger
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
+from named_poses.follow_server import FollowServer
 from named_poses.params import FILE_KEYS, load_settings
 from named_poses.path_cap import PathCap
 from named_poses.poses import NamedPoses, PoseError, urdf_joints
@@ -104,6 +105,7 @@ class NamedPoseServer:
         self._health = DiagnosticsPublisher(self._health_report)
         rospy.Service("~move_to", MoveToNamedPose, self._move_to)
         rospy.Service("~move_to_joints", MoveToJoints, self._move_to_joints)
+        self._follow = FollowServer(self, settings, urdf_joints(urdf))
         rospy.loginfo(
             "named_pose_server: poses %s for joints %s", sorted(self.poses.poses), list(self.poses.joints)
         )

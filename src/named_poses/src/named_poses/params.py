@@ -71,6 +71,24 @@ class NamedPoseSettings:
         "/contact_control_node/status", nonempty=True,
         doc="compliant_control_msgs/ContactControlStatus input: no move while a contact move runs",
     )
+    # ~follow_joint_trajectory (README, FollowJointTrajectory)
+    contact_wrench: str = param(
+        "/contact_control_node/contact_wrench", nonempty=True,
+        doc="geometry_msgs/WrenchStamped input while a trajectory runs: contact_control's contact force",
+    )
+    trajectory_force_limit: float = param(
+        20.0, unit="N", gt=0.0, doc="a trajectory stops when the contact force reaches this "
+        "(PATH_TOLERANCE_VIOLATED; jog_arm's contact guard stops a jog at 20 N too)",
+    )
+    trajectory_path_tolerance: float = param(
+        0.0, unit="rad or m", ge=0.0, doc="a joint further than this from where the trajectory should be has "
+        "it stopped, unless the goal gives its own; 0: none (ros_control's default)",
+    )
+    trajectory_goal_time: float = param(
+        1.0, unit="s", gt=0.0, doc="how long after the last point the arm may take to get within the goal "
+        "tolerance (`goal_tolerance` unless the goal gives its own), unless the goal gives its own",
+    )
+    trajectory_feedback_rate: float = param(10.0, unit="Hz", gt=0.0, le=100.0, doc="feedback while it runs")
 
 
 PARAMETERS = schema_of(NamedPoseSettings)
