@@ -146,16 +146,19 @@ class NormalFollower:
                                 f"followed one (more than normal_jump {math.degrees(self.jump):.1f} deg): "
                                 "not followed, the tool's orientation holds")
                 return _ZERO
-            followed = _turn(followed, seen, min(off, self.max_rate * dt))
+            step = self.max_rate * dt
+            followed = seen if off <= step else _turn(followed, seen, step)
         self._normal, self.message = followed, ""
         # The tool points into the surface: its axis goes to -normal, or +normal for a sensor whose z axis
         # points away from the tool (the side the axis is on now decides).
-        target = followed if _dot(axis, followed) > 0.0 else (-followed[0], -followed[1], -followed[2])
-        turn = _unit(_cross(axis, target))
-        if turn is None:
+        along = _dot(axis, followed)
+        sign = 1.0 if along > 0.0 else -1.0
+        c = _cross(axis, followed)
+        size = math.sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2])
+        if size < 1e-12:
             return _ZERO
-        angle = _angle(axis, target)
-        return (turn[0] * angle, turn[1] * angle, turn[2] * angle)
+        k = sign * math.atan2(size, sign * along) / size  # the angle to the target, along the unit cross
+        return (c[0] * k, c[1] * k, c[2] * k)
 
     def control_step(self, wrench: Sequence[float], velocity: Sequence[float], dt: float,
                      T_control_sensor: Matrix | None, R_fixed_control: Matrix | None) -> Vec3:
