@@ -60,6 +60,8 @@ def test_the_wipe_task_presses_10_n_and_keeps_the_tool_normal_over_a_cylinder(ro
     args = {"fixture": "cylinder", "surface_offset": f"[{OFFSET[0]}, {OFFSET[1]}, {OFFSET[2]}]"}
     with task_stack(args) as (h, client, _tool):
         assert rospy.ServiceProxy("/named_poses/move_to", MoveToNamedPose)(name="start").success
+        truth = rospy.get_param("/mujoco_driver/surface")  # the driver's ground truth, for this test only
+        assert truth["kind"] == "cylinder" and truth["top"] == pytest.approx(TOP)
         dynamic_reconfigure.client.Client("/contact_control_node", timeout=20).update_configuration(
             {"normal_friction": 0.3})
         pose = Collector("/mujoco_driver/eef_pose", PoseStamped)

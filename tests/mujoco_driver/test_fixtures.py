@@ -125,3 +125,24 @@ def test_a_seeded_surface_is_off_by_up_to_10_mm_the_same_way_for_the_same_seed()
     assert offsets[0] == offsets[2] != offsets[1]
     assert all(0.0 < abs(d) <= 0.01 for offset in offsets for d in offset)
     assert _height("sphere", 0.6, 0.1, surface_seed=1) != pytest.approx(0.13, abs=1e-4)
+
+
+def test_the_drivers_surface_truth_says_where_the_part_is():
+    from mujoco_driver.params import DriverSettings, load_scene
+    from mujoco_driver.scene import surface_truth
+
+    scene = {"start_pose": [0.0], "servo": {"kp": 1.0, "kv": 1.0},
+             "obstacle": {"position": [0.6, 0.1, 0.065], "size": [0.15, 0.15, 0.13]}}
+
+    def truth(**params):
+        cfg = load_scene(DriverSettings.from_params({"scene": scene, **params}))
+        return surface_truth(cfg.obstacle, cfg.surface)
+
+    got = truth(fixture="cylinder", surface_offset=[0.004, -0.003, 0.005])
+    assert got["kind"] == "cylinder" and got["radius"] == 0.25
+    assert got["top"] == pytest.approx([0.604, 0.097, 0.135])
+    tilted = truth(fixture="tilted")
+    assert tilted["rpy"] == pytest.approx([0.0, 0.2618, 0.0])
+    # the top face's centre: the block's centre plus half its height along the turned z axis
+    half, tilt = 0.065, 0.2618
+    assert tilted["top"] == pytest.approx([0.6 + half * math.sin(tilt), 0.1, 0.065 + half * math.cos(tilt)])

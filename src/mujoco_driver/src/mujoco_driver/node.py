@@ -45,7 +45,7 @@ from mujoco_driver.pacing import Pacer, RtfMeter, TrailingPublication
 from mujoco_driver.params import DriverParamError, DriverSettings, load_scene, urdf_root_link
 from mujoco_driver.profiles import DriverProfile, ProfileError
 from mujoco_driver.ros_emulation import EmulatedDriver, resolve_profile
-from mujoco_driver.scene import SceneError
+from mujoco_driver.scene import SceneError, surface_truth
 from mujoco_driver.sim import CommandError, Simulation
 
 __all__ = ["MujocoDriverNode", "main"]
@@ -83,6 +83,8 @@ class MujocoDriverNode:
         self._sim = sim = Simulation(urdf, scene_cfg)
         if scene_cfg.hole is not None and scene_cfg.obstacle is not None:  # ground truth, for plots and tests
             rospy.set_param("~hole_pose", list(hole_pose(scene_cfg.obstacle, scene_cfg.hole)))
+        if scene_cfg.surface is not None and scene_cfg.obstacle is not None:
+            rospy.set_param("~surface", surface_truth(scene_cfg.obstacle, scene_cfg.surface))
         for entry in sim.scene.geometry:  # meshes converted or replaced for MuJoCo: say so, per link
             if entry.changed:
                 rospy.loginfo("mujoco_driver: collision geometry of %s", entry)

@@ -36,7 +36,7 @@ from mujoco_driver.meshes import LinkGeometry, prepare_collision
 
 __all__ = [
     "SceneError", "SceneModel", "UrdfJoint", "build_scene", "mujoco_urdf", "mujoco_urdf_report",
-    "rpy_to_quat", "surface_top", "urdf_joints",
+    "rpy_to_quat", "surface_top", "surface_truth", "urdf_joints",
 ]
 
 _log = logging.getLogger(__name__)
@@ -296,6 +296,19 @@ def _add_curved(world: mujoco.MjsBody, block: Box, surface: Surface) -> mujoco.M
                               quat=[math.sqrt(0.5), math.sqrt(0.5), 0.0, 0.0], rgba=[0.8, 0.2, 0.2, 1.0])
     return world.add_geom(name="obstacle", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[surface.radius, 0.0, 0.0],
                           pos=centre, rgba=[0.8, 0.2, 0.2, 1.0])
+
+
+def surface_truth(block: Box, surface: Surface) -> dict[str, object]:
+    """Where the finishing fixture truly is (the driver's `~surface`, for plots and tests): its kind, radius
+    [m], top [m] (a curved part's highest point; the tilted block's top face centre) and, for the tilted
+    block, its rpy [rad]."""
+    if surface.kind == "plane":
+        R = np.zeros(9)
+        mujoco.mju_quat2Mat(R, rpy_to_quat(block.rpy))
+        top = np.asarray(block.position) + R.reshape(3, 3)[:, 2] * block.size[2] / 2.0
+        return {"kind": "tilted", "radius": 0.0, "top": [float(x) for x in top], "rpy": list(block.rpy)}
+    return {"kind": surface.kind, "radius": surface.radius, "top": list(surface_top(block, surface)),
+            "rpy": [0.0, 0.0, 0.0]}
 
 
 def surface_top(block: Box, surface: Surface) -> tuple[float, float, float]:
