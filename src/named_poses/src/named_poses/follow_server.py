@@ -116,14 +116,9 @@ class FollowServer:
 
     def _run(self, goal: FollowJointTrajectoryGoal) -> tuple[int, str]:
         poses = self.poses
-        if poses._robot_stop:
-            return R.INVALID_GOAL, f"refused: {poses._robot_stop}: recover it first ({poses._jog}/recover)"
-        if poses._contact_move_running() is not False:
-            return R.INVALID_GOAL, ("refused: a contact move is running (or contact_control's status did not "
-                                    "come): stop it first (rosservice call /contact_control_node/stop)")
-        current = poses._first_state()
+        why, current = poses.ready()  # the same refusals as a named-pose move's
         if current is None:
-            return R.INVALID_GOAL, f"refused: no joint state for {list(poses.poses.joints)}"
+            return R.INVALID_GOAL, f"refused: {why}"
         plan = self._plan(goal, current)
         stamp = goal.trajectory.header.stamp
         start = stamp.to_sec() if not stamp.is_zero() else rospy.get_time()

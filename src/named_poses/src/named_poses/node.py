@@ -228,25 +228,9 @@ class NamedPoseServer:
         scale = speed_scale or 1.0
         if not 0.0 < scale <= 1.0:
             return self._refuse(f"speed_scale must be in (0, 1], got {speed_scale}")
-        if self._robot_stop:
-            return self._refuse(f"{self._robot_stop}: recover it first ({self._jog}/recover)")
-        running = self._contact_move_running()
-        if running is None:
-            return self._refuse(
-                f"no status from contact_control within {self.state_wait:g} s although it publishes "
-                f"{self._status_topic}: cannot tell whether a contact move runs"
-            )
-        if running:
-            return self._refuse(
-                "a contact move is running (contact_control ~status move_active): stop it first "
-                "(rosservice call /contact_control_node/stop)"
-            )
-        current = self._first_state()
+        why, current = self.ready()
         if current is None:
-            return self._refuse(
-                f"no joint state for {list(self.poses.joints)} within {self.state_wait:g} s "
-                f"(is the driver publishing {self._states_topic}?)"
-            )
+            return self._refuse(why)
         region = rospy.get_param(f"{self._jog}/collaborative_region", "hand") if self._jog else "hand"
         payload = rospy.get_param(f"{self._jog}/collaborative_payload", 0.0) if self._jog else 0.0
         try:
@@ -289,6 +273,24 @@ class NamedPoseServer:
             answer.message += (f"; slowed to the collaborative speed cap ({tip_speed:.2f} m/s at the tip "
                                f"toward the {region}, ISO/TS 15066)")
         return answer
+
+    def ready(self) -> tuple[str, np.ndarray | None]:
+        """The joints now, or why no move may start ('', joints): the robot stopped by itself, a contact move
+        running (or no status to tell), no joint state within `~state_wait`."""
+        if self._robot_stop:
+            return f"{self._robot_stop}: recover it first ({self._jog}/recover)", None
+        running = self._contact_move_running()
+        if running is None:
+            return (f"no status from contact_control within {self.state_wait:g} s although it publishes "
+                    f"{self._status_topic}: cannot tell whether a contact move runs"), None
+        if running:
+            return ("a contact move is running (contact_control ~status move_active): stop it first "
+                    "(rosservice call /contact_control_node/stop)"), None
+        current = self._first_state()
+        if current is None:
+            return (f"no joint state for {list(self.poses.joints)} within {self.state_wait:g} s "
+                    f"(is the driver publishing {self._states_topic}?)"), None
+        return "", current
 
     # --- jog_arm pause (README, Jogging during a move) ---
     def _pause_jog(self) -> bool:
