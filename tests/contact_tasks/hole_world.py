@@ -10,6 +10,7 @@ Coulomb-like friction opposes sliding on the plate.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -90,6 +91,9 @@ class TaskLoop:
         self.commands: list[Command] = []
         self._touched = False
         self._was_touching = False
+        self._tool_axes = False  # the laws act along the tool's axes (a request's frame), not the plate's
+        #: Called with the run and each observation after the run's update (a test's own measurements).
+        self.watch: Callable[[TaskRun, Observation], None] | None = None
         #: From this time on the robot is stopped by its driver (held; jog_arm's ~robot_stop says `stop_why`).
         self.stop_at, self.stop_why = math.inf, "the robot stopped: a protective stop"
 
@@ -99,6 +103,7 @@ class TaskLoop:
             r = command.reference
             self.ctrl.set_path_reference(r.position, r.quaternion, r.twist, self.t, r.horizon, r.horizon_step)
         if command.laws is not None:
+            self._tool_axes = bool(getattr(command.laws, "frame", ""))
             if command.restart:
                 self.ctrl.stop("the next step")
             self.ctrl.set_laws(validate_laws_request(command.laws), self.pose, self.t)
@@ -111,18 +116,29 @@ class TaskLoop:
         self._apply(command)
         cycle = 0
         while self.run.running and self.t < seconds:
-            result = self.ctrl.update(wrench, self.t, eef_pose=self.pose)
+            if self._tool_axes:  # as contact_control's stage turns them: sensor (plate axes) into the tool's
+                R = self.pose[:3, :3]
+                T_cs = np.eye(4)
+                T_cs[:3, :3] = R.T
+                result = self.ctrl.update(wrench, self.t, T_cs.tolist(), None, self.pose, R.tolist())
+                linear = R @ np.asarray(result.velocity[:3])
+            else:
+                result = self.ctrl.update(wrench, self.t, eef_pose=self.pose)
+                linear = np.asarray(result.velocity[:3])
             touching = math.sqrt(sum(f * f for f in result.wrench[:3])) >= 3.0
             self._touched |= touching and not self._was_touching
             self._was_touching = touching
             if self.t < self.stop_at:  # held by the driver after it
-                self.pose[:3, 3] += np.asarray(result.velocity[:3]) * DT
+                self.pose[:3, 3] += linear * DT
             self.t += DT
             wrench = self.world.wrench(self.pose)
             self.trace.append((self.t, *self.pose[:3, 3], wrench[2]))
             cycle += 1
             if cycle % self.every == 0:
-                command = self.run.update(self._observe(result.wrench, result.move_active))
+                obs = self._observe(result.wrench, result.move_active)
+                command = self.run.update(obs)
+                if self.watch is not None:
+                    self.watch(self.run, obs)
                 self._apply(command)
         return command
 

@@ -144,3 +144,24 @@ def test_build_description_rejects_non_urdf():
         build_description("<robot")
     with pytest.raises(DescriptionError, match="<robot>"):
         build_description("<mujoco/>")
+
+
+def test_a_rounded_tool_ends_in_a_ball_at_the_same_tip(run_make_description):
+    """--tool-rounded: the cylinder's end becomes a hemisphere of its radius; the tip, mass and centre of mass
+    stay (a ball-end tool for curved parts)."""
+    result = run_make_description("--source", UR5, *TOOL_ARGS, "--tool-size", "0.03", "0.12",
+                                  "--tool-rounded")
+    assert result.returncode == 0, result.stderr
+    tool = next(link for link in ET.fromstring(result.stdout).findall("link") if link.get("name") == "tool")
+    shapes = {c.find("geometry")[0].tag: c.find("origin").get("xyz") for c in tool.findall("collision")}
+    assert set(shapes) == {"cylinder", "sphere"}
+    assert [float(v) for v in shapes["sphere"].split()] == pytest.approx([0.0, 0.0, 0.09])  # 0.12 - 0.03
+    sphere = tool.find("collision/geometry/sphere")
+    assert sphere is not None and float(sphere.get("radius")) == pytest.approx(0.03)
+    model = pin.buildModelFromXML(result.stdout)
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, pin.neutral(model))
+    sensor, tip = data.oMf[model.getFrameId("ft_sensor")], data.oMf[model.getFrameId("tool_tip")]
+    assert np.allclose(sensor.actInv(tip.translation), [0, 0, 0.12])  # the ball's bottom is the tip
+    with pytest.raises(DescriptionError, match="rounded end needs a cylinder"):
+        ToolSpec(parent="tool0", shape="box", size=(0.01, 0.01, 0.1), rounded=True).validate()

@@ -1,5 +1,5 @@
-"""controller_manager_msgs, franka_msgs and ur_dashboard_msgs (the subsets the emulated drivers serve) and
-control_msgs (named_poses' FollowJointTrajectory server) keep
+"""controller_manager_msgs, franka_msgs and ur_dashboard_msgs (the subsets the emulated drivers serve),
+control_msgs (named_poses' FollowJointTrajectory server) and nav_msgs (contact_tasks' ~follow_path) keep
 the real packages' wire format: genmsg computes an md5sum from the definition text, so identical fields and
 constants give the md5sums that the upstream packages' generated code carries."""
 
@@ -15,6 +15,7 @@ from control_msgs.msg import (
 )
 from controller_manager_msgs import msg, srv
 from franka_msgs.msg import ErrorRecoveryActionGoal, ErrorRecoveryGoal, ErrorRecoveryResult, FrankaState
+from nav_msgs.msg import OccupancyGrid, Odometry, Path
 from ur_dashboard_msgs.msg import RobotMode, SafetyMode
 
 # From ros_control's generated code (Noetic, controller_manager_msgs 0.19/0.20) and franka_msgs.
@@ -37,6 +38,10 @@ MD5 = {
     FollowJointTrajectoryResult: "493383b18409bfb604b4e26c676401d2",
     FollowJointTrajectoryFeedback: "10817c60c2486ef6b33e97dcd87f4474",
     JointTolerance: "f544fe9c16cf04547e135dd6063ff5be",
+    # nav_msgs 1.13 (Noetic), as rosbag's connection headers of recorded paths and odometry carry them.
+    Path: "6227e2b7e9cce15051f669a5e197bbf7",
+    Odometry: "cd5e73d190d741a2f92e81eda573aca7",
+    OccupancyGrid: "3381f2d731d4076ec5c71b0759edbe4e",
 }
 
 

@@ -141,6 +141,7 @@ def test_the_drivers_surface_truth_says_where_the_part_is():
     got = truth(fixture="cylinder", surface_offset=[0.004, -0.003, 0.005])
     assert got["kind"] == "cylinder" and got["radius"] == 0.25
     assert got["top"] == pytest.approx([0.604, 0.097, 0.135])
+    assert got["friction"] == pytest.approx(0.3)
     tilted = truth(fixture="tilted")
     assert tilted["rpy"] == pytest.approx([0.0, 0.2618, 0.0])
     # the top face's centre: the block's centre plus half its height along the turned z axis

@@ -279,7 +279,8 @@ class ContactControl:
             if c.is_path[i]:
                 target = path_velocity(c.laws[i], tuning[i], w[i], error[i], reference[i])
             elif turn is not None and i in c.normal_axes:
-                target = normal_velocity(c.laws[i], turn[i - 3])
+                # with a path: its reference's turn fed forward (the surface as planned), the force the rest
+                target = normal_velocity(c.laws[i], turn[i - 3]) + (reference[i] if c.path_axes else 0.0)
             else:
                 target = law_velocity(c.laws[i], tuning[i], w[i], travel[i])
                 if c.guarded[i]:

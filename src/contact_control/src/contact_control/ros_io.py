@@ -181,9 +181,10 @@ class ContactControlRos:
         if self._contact_pub.get_num_connections() > 0:
             contact = self._stage.contact
             if contact is not None:
-                force, _frame, t = contact
+                force, frame, t = contact
                 msg = self._contact_msg
                 msg.header.stamp = rospy.Time.from_sec(t)
+                msg.header.frame_id = frame
                 f = msg.wrench.force
                 f.x, f.y, f.z = force
                 self._contact_pub.publish(msg)
@@ -207,7 +208,7 @@ class ContactControlRos:
         msg = ContactEvent(type=event.kind, type_name=EVENT_NAMES[event.kind], move_id=event.move_id,
                            message=event.message)
         msg.header.stamp = rospy.Time.from_sec(event.t)
-        msg.header.frame_id = self._s.control_frame
+        msg.header.frame_id = self._stage.frame
         f, q = msg.wrench.force, msg.wrench.torque
         f.x, f.y, f.z, q.x, q.y, q.z = event.wrench
         if event.pose is not None:
@@ -399,6 +400,7 @@ class ContactControlRos:
             # replay just after hand-guiding was switched off: "a contact move is running").
             active, reacting = self._stage.ctrl.move_active, any(self._stage.ctrl.reacting())
         msg = self._status_msg  # reused: the status timer allocates nothing per cycle
+        msg.header.frame_id = self._stage.frame
         msg.header.stamp = stamp
         msg.guiding = guiding
         msg.safety = r.safety

@@ -100,6 +100,9 @@ class ContactStage:
         self.frames_used = frozenset(
             {s.control_frame, s.ft_sensor_frame, s.eef_frame, s.velocity_command_frame} - {s.fixed_frame}
         )
+        #: The frame whose axes the running laws act along (a ConfigureLaws request's `frame`, else
+        #: control_frame).
+        self.frame = s.control_frame
         self._period = 1.0 / s.control_rate
         self._idle_zeros = 0
         self._was_active = False
@@ -148,10 +151,11 @@ class ContactStage:
         """
         s = self.settings
         self._cycle_poses.clear()
-        T_fixed_control = self._pose(s.control_frame)
-        R_fixed_control = None if s.control_frame == s.fixed_frame else rotation(T_fixed_control)
+        control = self.frame
+        T_fixed_control = self._pose(control)
+        R_fixed_control = None if control == s.fixed_frame else rotation(T_fixed_control)
         T_control_sensor = None
-        if sensor_frame != s.control_frame or sensor_frame != s.eef_frame:
+        if sensor_frame != control or sensor_frame != s.eef_frame:
             # Axes: the control frame's; reference point: the end effector, which the twist moves (a push on
             # the tool is no torque there, wherever the control frame's origin is: README, Preprocessing).
             T_fixed_sensor, T_fixed_eef = self._pose(sensor_frame), self._pose(s.eef_frame)
@@ -161,7 +165,7 @@ class ContactStage:
         R_world_sensor = rotation(self._pose(sensor_frame)) if self._gravity else None
         eef = self._pose(s.eef_frame) if self.ctrl.needs_travel else None
         R_command_control = None
-        if s.velocity_command_frame != s.control_frame:
+        if s.velocity_command_frame != control:
             R_fixed_command = rotation(self._pose(s.velocity_command_frame))
             R_command_control = transpose_times(R_fixed_command, rotation(T_fixed_control))
         return T_control_sensor, R_world_sensor, eef, R_fixed_control, R_command_control
@@ -235,7 +239,7 @@ class ContactStage:
             self._have_frames = False
             force = self.ctrl.intake.contact_force(self._last_raw, *self._last_frames)
             if force is not None:
-                self.contact = (force, self.settings.control_frame, self._last_t)
+                self.contact = (force, self.frame, self._last_t)
         return self.contact
 
     # --- time ---
@@ -372,6 +376,7 @@ class ContactStage:
         except RequestError as err:
             return self._refuse(err.code, f"hand-guiding refused: {err.message}"), None
         self._guide_move = move_id
+        self.frame = s.control_frame  # guiding follows the push along control_frame's axes
         self._request_note = ""
         self._idle_zeros = int(s.idle_zero_count)
         self.ended = True
@@ -397,8 +402,12 @@ class ContactStage:
             return refused
         validate = validate_laws_request if per_axis else validate_request
         try:
+            frame = self._request_frame(req if per_axis else None)
             laws, limited = self.ctrl.bound_gains(validate(req, self.limits))
+            if frame != self.frame:  # the running move's velocities are along the old frame's axes
+                self.ctrl.stop(f"the laws' frame changed from {self.frame} to {frame}")
             move_id = self.ctrl.set_laws(laws, None, t)
+            self.frame = frame
         except RequestError as err:
             self._request_note = f"last request refused (code {err.code}): {err.message}"
             return Answer(False, err.code, err.message, 0)
@@ -406,6 +415,8 @@ class ContactStage:
         self._idle_zeros = int(self.settings.idle_zero_count)
         self.ended = True  # a blocking caller of a replaced move answers now
         message = describe_laws(move_id, laws)
+        if self.frame != self.settings.control_frame:
+            message += f" (axes of {self.frame})"
         if limited:
             message += "; gains lowered for the sensor's rate: " + ", ".join(limited)
         if self.ctrl.intake.zeroing:
@@ -414,6 +425,18 @@ class ContactStage:
                 "shows safety ok; keep the tool free until then, a touch now would be taken as the zero"
             )
         return Answer(True, SUCCESS, message, move_id)
+
+    def _request_frame(self, req: LawsRequest | None) -> str:
+        """The frame a request's laws act along, checked to be available now (RequestError if not)."""
+        s = self.settings
+        given = str(getattr(req, "frame", "") or "") if req is not None else ""
+        frame = given.lstrip("/") or s.control_frame
+        if frame != s.fixed_frame:
+            try:
+                self._poses(frame)
+            except LookupError as err:
+                raise RequestError(FAILURE, f"frame: {frame!r} is not available ({err})") from err
+        return frame
 
     def stop(self, reason: str) -> Velocity | None:
         """Ends the running move; a zero twist to send if one was running."""

@@ -39,6 +39,7 @@ from std_msgs.msg import String
 from std_srvs.srv import Trigger
 
 from contact_tasks.params import TaskServerSettings, load_settings
+from contact_tasks.path_server import FollowPathServer
 from contact_tasks.run import FAILED, RUNNING, SUCCEEDED, Command, Observation, TaskRun
 from contact_tasks.task import AXIS_NAMES, Task, TaskError
 from contact_tasks.task_file import load_task, load_task_file
@@ -56,11 +57,11 @@ class TaskServer:
     def __init__(self, s: TaskServerSettings, fixed_frame: str, eef_frame: str, tasks_dir: str) -> None:
         self.s, self.fixed_frame, self.eef_frame, self.tasks_dir = s, fixed_frame, eef_frame, tasks_dir
         cc = rospy.resolve_name(s.contact_control_node)
-        self._cc = cc
+        self.cc = cc
         self._ref_pub = rospy.Publisher(cc + "/path_reference", PathReference, queue_size=1, tcp_nodelay=True)
         self._configure = rospy.ServiceProxy(rospy.resolve_name("configure_laws"), ConfigureLaws)
         self._stop = rospy.ServiceProxy(cc + "/stop", Trigger)
-        self._tf = tf2_ros.Buffer()
+        self.tf = tf2_ros.Buffer()
         self._listener: tf2_ros.TransformListener | None = None
         self._lock = threading.Lock()
         self._status: ContactControlStatus | None = None
@@ -71,9 +72,12 @@ class TaskServer:
         self._subs: list[rospy.Subscriber] = []
         self._run: TaskRun | None = None  # the task running, for /diagnostics
         self._last = "idle"
+        #: Held while a task or a path runs: one at a time.
+        self.busy = threading.Lock()
         self._server = actionlib.SimpleActionServer("~execute", ExecuteTaskAction, self._execute,
                                                     auto_start=False)
         self._server.start()
+        self._paths = FollowPathServer(self)
         self._health = DiagnosticsPublisher(self._health_report)
 
     def _health_report(self) -> Report:
@@ -90,10 +94,10 @@ class TaskServer:
 
     def _listen(self) -> None:
         if self._listener is None:
-            self._listener = tf2_ros.TransformListener(self._tf)
+            self._listener = tf2_ros.TransformListener(self.tf)
         self._subs = [
-            rospy.Subscriber(self._cc + "/status", ContactControlStatus, self._on_status, queue_size=1),
-            rospy.Subscriber(self._cc + "/events", ContactEvent, self._on_event, queue_size=50),
+            rospy.Subscriber(self.cc + "/status", ContactControlStatus, self._on_status, queue_size=1),
+            rospy.Subscriber(self.cc + "/events", ContactEvent, self._on_event, queue_size=50),
             rospy.Subscriber(self.s.jog_arm + "/robot_stop", String, self._on_robot_stop, queue_size=5),
         ]
 
@@ -133,7 +137,7 @@ class TaskServer:
 
     def _tool(self) -> FloatArray | None:
         try:
-            tf = self._tf.lookup_transform(self.fixed_frame, self.eef_frame, rospy.Time(0))
+            tf = self.tf.lookup_transform(self.fixed_frame, self.eef_frame, rospy.Time(0))
         except _TF_ERRORS:
             return None
         p, q = tf.transform.translation, tf.transform.rotation
@@ -174,7 +178,7 @@ class TaskServer:
         if command.laws is not None:
             if command.restart:
                 self._call_stop()
-            req = ConfigureLawsRequest()
+            req = ConfigureLawsRequest(frame=getattr(command.laws, "frame", ""))
             for axis in AXIS_NAMES:
                 given, law = getattr(command.laws, axis), getattr(req, axis)
                 for name in _LAW_FIELDS:
@@ -207,6 +211,16 @@ class TaskServer:
         return load_task_file(os.path.join(self.tasks_dir, goal.task + ".yaml"), goal.overrides)
 
     def _execute(self, goal: ExecuteTaskGoal) -> None:
+        if not self.busy.acquire(blocking=False):
+            why = "refused: another task or path runs on this task_server"
+            self._server.set_aborted(ExecuteTaskResult(outcome="refused", message=why), why)
+            return
+        try:
+            self._execute_task(goal)
+        finally:
+            self.busy.release()
+
+    def _execute_task(self, goal: ExecuteTaskGoal) -> None:
         try:
             task = self._load(goal)
         except TaskError as err:
@@ -217,12 +231,10 @@ class TaskServer:
         except TaskError as err:
             self._server.set_aborted(ExecuteTaskResult(outcome="refused", message=str(err)), str(err))
             return
-        self._listen()
         answer = self._server.set_aborted, ExecuteTaskResult(outcome="refused", message="shutting down")
         try:
             answer = self._carry_out(task)
         finally:
-            self._unlisten()
             if before:  # the robot's own region back before the answer: the caller may act on it at once
                 try:
                     self._set_region(before)
@@ -254,59 +266,98 @@ class TaskServer:
     def _carry_out(self, task: Task) -> tuple[Callable[..., None], ExecuteTaskResult]:
         """Runs the task; how to answer (the action server's set_succeeded, _aborted or _preempted) and
         with what."""
-        began = rospy.get_time()
+        feedback, began = ExecuteTaskFeedback(), rospy.get_time()
+
+        def publish(run: TaskRun, obs: Observation) -> None:
+            feedback.step, feedback.elapsed = run.step_name, obs.t - began
+            w = feedback.wrench
+            w.force.x, w.force.y, w.force.z = obs.wrench[:3]
+            w.torque.x, w.torque.y, w.torque.z = obs.wrench[3:]
+            feedback.depth, feedback.search_radius = run.depth, run.search_radius
+            self._server.publish_feedback(feedback)
+
+        run, why = self.carry_out(task, self._server.is_preempt_requested, feedback=publish)
+        if run is None:
+            return self._server.set_aborted, ExecuteTaskResult(outcome="refused", message=why)
+        result = self._result(run)
+        return self.answer(self._server, run), result
+
+    def carry_out(self, task: Task | Callable[[FloatArray], Task], preempted: Callable[[], bool],
+                  watch: Callable[[TaskRun, Observation], None] | None = None,
+                  feedback: Callable[[TaskRun, Observation], None] | None = None,
+                  ) -> tuple[TaskRun | None, str]:
+        """Runs `task` (or the one a builder makes from the tool's pose once it is known; a TaskError it
+        raises refuses) until it ends, is `preempted` or the node shuts down; `watch` sees every observation
+        after the run's update, `feedback` one in `rate / feedback_rate`. (the run, "") or (None, why it could
+        not start)."""
         with self._lock:
             self._touched = self._released = False
-            self._not_before = began
+            self._not_before = rospy.get_time()
+        self._listen()
+        try:
+            return self._loop(task, preempted, watch, feedback)
+        finally:
+            self._unlisten()
+            with self._lock:
+                self._not_before = math.inf
+                self._run = None
+
+    def _loop(self, task: Task | Callable[[FloatArray], Task], preempted: Callable[[], bool],
+              watch: Callable[[TaskRun, Observation], None] | None,
+              feedback: Callable[[TaskRun, Observation], None] | None) -> tuple[TaskRun | None, str]:
         status, tool = self._wait_for_inputs()
-        why = ""
         if status is None:
-            why = (f"no ~status from {self._cc} within {self.s.status_timeout:g} s: is contact_control "
-                   "running?")
-        elif tool is None:
-            why = f"no transform {self.fixed_frame} -> {self.eef_frame}: the tool's pose is unknown"
-        if why or tool is None:
-            return self._server.set_aborted, ExecuteTaskResult(outcome="refused", message=why)
+            return None, (f"no ~status from {self.cc} within {self.s.status_timeout:g} s: is "
+                          "contact_control running?")
+        if tool is None:
+            return None, f"no transform {self.fixed_frame} -> {self.eef_frame}: the tool's pose is unknown"
+        if not isinstance(task, Task):
+            try:
+                task = task(tool)
+            except TaskError as err:
+                return None, str(err)
         self._laws_at = math.inf
-        run = TaskRun(task, self.s.path_horizon, self.s.path_horizon_step)
+        run = TaskRun(task, self.s.path_horizon, self.s.path_horizon_step, self.eef_frame)
         obs = self._observe(tool)
-        command = self._apply(run, run.start(obs), obs)
+        self._apply(run, run.start(obs), obs)
         rate, every = rospy.Rate(self.s.rate), max(1, round(self.s.rate / self.s.feedback_rate))
-        feedback, cycle = ExecuteTaskFeedback(), 0
+        cycle = 0
         with self._lock:
             self._run = run
         while run.running and not rospy.is_shutdown():
             rate.sleep()
             tool = self._tool()
             if tool is None:
-                lost = run.refused("the tool's pose is no longer available (tf)", obs)
-                command = self._apply(run, lost, obs)
+                self._apply(run, run.refused("the tool's pose is no longer available (tf)", obs), obs)
                 break
             obs = self._observe(tool)
-            if self._server.is_preempt_requested():
-                command = self._apply(run, run.cancel(obs), obs)
+            if preempted():
+                self._apply(run, run.cancel(obs), obs)
                 break
-            command = self._apply(run, run.update(obs), obs)
+            self._apply(run, run.update(obs), obs)
+            if watch is not None:
+                watch(run, obs)
             cycle += 1
-            if cycle % every == 0 and run.running:
-                feedback.step, feedback.elapsed = run.step_name, obs.t - began
-                w = feedback.wrench
-                w.force.x, w.force.y, w.force.z = obs.wrench[:3]
-                w.torque.x, w.torque.y, w.torque.z = obs.wrench[3:]
-                feedback.depth, feedback.search_radius = run.depth, run.search_radius
-                self._server.publish_feedback(feedback)
+            if feedback is not None and cycle % every == 0 and run.running:
+                feedback(run, obs)
         if run.running:  # shutting down
-            command = self._apply(run, run.cancel(obs), obs)
-        result = self._result(run)
+            self._apply(run, run.cancel(obs), obs)
+        r = run.result
         with self._lock:
-            self._not_before = math.inf
-            self._run, self._last = None, f"last task '{task.name}': {result.outcome}: {result.message}"
-        rospy.loginfo("task_server: task '%s' %s: %s", task.name, result.outcome, result.message)
-        if command.outcome == SUCCEEDED:
-            return self._server.set_succeeded, result
-        if command.outcome in (FAILED, RUNNING):
-            return self._server.set_aborted, result
-        return self._server.set_preempted, result
+            self._last = f"last task '{task.name}': {r.outcome}: {r.reason}"
+        rospy.loginfo("task_server: task '%s' %s: %s", task.name, r.outcome, r.reason)
+        return run, ""
+
+    @staticmethod
+    def answer(server: actionlib.SimpleActionServer, run: TaskRun) -> Callable[..., None]:
+        """The action server's set_succeeded, _aborted or _preempted for how `run` ended."""
+        outcome = run.result.outcome
+        send: Callable[..., None] = server.set_preempted
+        if outcome == SUCCEEDED:
+            send = server.set_succeeded
+        elif outcome in (FAILED, RUNNING):
+            send = server.set_aborted
+        return send
 
     def _result(self, run: TaskRun) -> ExecuteTaskResult:
         r = run.result

@@ -10,13 +10,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from compliant_common.typedefs import FloatArray
 from contact_control.frames import matrix_quaternion, quaternion_matrix
 from contact_control.travel import rotation_vector
 
+from contact_tasks.path import PathPoint, PosePath
 from contact_tasks.patterns import PatternPoint, evaluate
 from contact_tasks.task import AXIS_NAMES, Exit, Law, Pattern, Step, Task
 from contact_tasks.task_file import laws_request
@@ -106,8 +107,11 @@ class Result:
 class TaskRun:
     """One run of a task; `start`, then `update` every cycle until the outcome is not RUNNING."""
 
-    def __init__(self, task: Task, horizon: float = 0.0, horizon_step: float = 0.02) -> None:
+    def __init__(self, task: Task, horizon: float = 0.0, horizon_step: float = 0.02,
+                 tool_frame: str = "tool_tip") -> None:
+        """`tool_frame`: contact_control's eef_frame, the axes of a step with `law_frame: tool`."""
         self.task = task
+        self.tool_frame = tool_frame
         self._ahead = (round(horizon / horizon_step) if horizon > 0.0 else 0, horizon_step)
         self.result = Result()
         self.step_name = ""
@@ -122,6 +126,10 @@ class TaskRun:
         self._started = 0.0  # [s] obs.t at the task's start
         self._since: dict[int, float] = {}  # exit index -> when its threshold began to hold
         self._failing = ""  # the task's failure reason while its on-failure step runs
+        self._path: PosePath | None = None  # a path pattern's, while its step runs
+        self._force = math.nan  # the target a path's segment set (nan: the step's own)
+        #: Where a path pattern's reference is, while its step runs (None: no path).
+        self.path_point: PathPoint | None = None
         sign = -1.0 if task.approach.startswith("-") else 1.0
         self._approach = np.zeros(3)
         self._approach[_DIRECTIONS[task.approach.lstrip("-")]] = sign
@@ -132,6 +140,8 @@ class TaskRun:
 
     def start(self, obs: Observation) -> Command:
         """Begins the task's first step at `obs`."""
+        if self.task.approach_frame == "tool":
+            self._approach = obs.tool[:3, :3] @ self._approach
         self._origin = obs.tool[:3, 3].copy()
         self._started = obs.t
         return self._begin(self.task.start, self.task.steps[self.task.start], obs)
@@ -165,12 +175,12 @@ class TaskRun:
             return self._fail(f"in step '{self.step_name}': the task ran longer than its time limit "
                               f"{task.time_limit:g} s", obs)
         step_t = obs.t - self._step_t
-        point = evaluate(self._step.pattern, step_t)
+        point = self._point(step_t)
         self.search_radius = point.radius
         for i, ex in enumerate(self._step.exits):
             if self._holds(i, ex, obs, step_t, point):
                 return self._take(ex, obs, obs.move_message if ex.when == "move_ended" else "")
-        return Command(self.step_name, reference=self._reference(point, step_t))
+        return Command(self.step_name, laws=self._segment_laws(), reference=self._reference(point, step_t))
 
     def cancel(self, obs: Observation) -> Command:
         """The task is cancelled: stop the move."""
@@ -192,8 +202,39 @@ class TaskRun:
         self._since.clear()
         self.search_radius = 0.0
         self.result.step_times.setdefault(name, 0.0)
-        reference = self._reference(evaluate(step.pattern, 0.0), 0.0) if _has_path(step) else None
-        return Command(name, laws=laws_request(step.laws), restart=restart, reference=reference)
+        pattern = step.pattern
+        self._path = None
+        if pattern.type == "path":
+            self._path = PosePath(pattern.poses, pattern.speed, pattern.angular_speed, pattern.ramp)
+        self.path_point, self._force = None, math.nan
+        reference = self._reference(self._point(0.0), 0.0) if _has_path(step) else None
+        laws = self._segment_laws() or laws_request(step.laws, self._law_frame(step))
+        return Command(name, laws=laws, restart=restart, reference=reference)
+
+    def _law_frame(self, step: Step) -> str:
+        return self.tool_frame if step.law_frame == "tool" else ""
+
+    def _point(self, step_t: float) -> PatternPoint:
+        """The step's pattern at `step_t`; a path's also in `path_point`."""
+        assert self._step is not None
+        if self._path is None:
+            return evaluate(self._step.pattern, step_t)
+        p = self.path_point = self._path.at(step_t)
+        return PatternPoint((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0,) * 6, p.done, p.arc)
+
+    def _segment_laws(self) -> object | None:
+        """The step's laws with the force of the path's segment when it changed (a bumpless change in
+        contact_control: same laws, new target), else None."""
+        step, point = self._step, self.path_point
+        if step is None or point is None or not step.pattern.forces:
+            return None
+        force = step.pattern.forces[point.segment]
+        if force == self._force:
+            return None
+        self._force = force
+        laws = {a: replace(law, target_force=force) if law.law == "force_tracking" else law
+                for a, law in step.laws.items()}
+        return laws_request(laws, self._law_frame(step))
 
     def _take(self, ex: Exit, obs: Observation, why: str) -> Command:
         """Takes exit `ex`; `why`: contact_control's word on how the step's move ended (a failure says it)."""
@@ -269,6 +310,8 @@ class TaskRun:
         """The reference at `point` (the pattern at `step_t` into the step) and its horizon."""
         if self._step is None or not _has_path(self._step):
             return None
+        if self._path is not None:
+            return self._path_reference(step_t)
         frame = self._frame
         linear = frame @ np.asarray(point.twist[:3])
         angular = frame @ np.asarray(point.twist[3:])
@@ -281,6 +324,15 @@ class TaskRun:
              float(angular[0]), float(angular[1]), float(angular[2])),
             horizon, step if horizon else 0.0,
         )
+
+    def _path_reference(self, step_t: float) -> Reference:
+        """A path pattern's reference: its own poses (fixed frame), not offsets from the step's start."""
+        assert self._path is not None
+        p = self._path.at(step_t)
+        count, step = self._ahead
+        horizon = tuple((h.position, h.quaternion) for h in (self._path.at(step_t + j * step)
+                                                              for j in range(1, count + 1)))
+        return Reference(p.position, p.quaternion, p.twist, horizon, step if horizon else 0.0)
 
     def _pose(self, point: PatternPoint) -> tuple[Position, Orientation]:
         """The fixed frame's position and quaternion of a pattern point."""
@@ -306,7 +358,7 @@ def _retract_step(task: Task) -> Step:
                      force_limit=r.force_limit, max_travel=r.distance)
     exits = (Exit(when="move_ended", fail="retracted"),
              Exit(when="timeout", after=r.timeout, fail=f"the retract did not end within {r.timeout:g} s"))
-    return Step(laws=laws, pattern=Pattern(), frame="fixed", exits=exits)
+    return Step(laws=laws, pattern=Pattern(), frame="fixed", exits=exits, law_frame=task.approach_frame)
 
 
 def _rotvec_quaternion(v: FloatArray) -> tuple[float, float, float, float]:

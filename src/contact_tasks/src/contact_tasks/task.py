@@ -35,7 +35,7 @@ __all__ = [
 AXIS_NAMES = ("x", "y", "z", "rx", "ry", "rz")
 #: What ends a step (see `Exit`).
 EXIT_KINDS = ("touch", "release", "move_ended", "force", "travel", "depth", "timeout", "pattern_done")
-PATTERN_KINDS = ("none", "line", "spiral", "lissajous", "wiggle")
+PATTERN_KINDS = ("none", "line", "spiral", "lissajous", "wiggle", "path")
 _LAW_KINDS = ("none", "follower", "spring", "compliant_move", "force_tracking", "path", "normal")
 _ACTIONS = ("stop", "move_away", "gravity_compensation")
 _SIGNED_AXES = (*AXIS_NAMES, *(f"-{a}" for a in AXIS_NAMES[:3]))
@@ -72,8 +72,9 @@ class Pattern:
     start."""
 
     type: str = param("none", choices=PATTERN_KINDS, doc="none, line, spiral (Archimedean), lissajous, "
-                      "wiggle (tilts about RX and RY)")
-    speed: float = param(0.005, unit="m/s", gt=0.0, le=0.5, doc="line and spiral: speed along the curve")
+                      "wiggle (tilts about RX and RY), path (given poses, not relative to the start)")
+    speed: float = param(0.005, unit="m/s", gt=0.0, le=0.5, doc="line, spiral and path: speed along the "
+                         "curve")
     axis: str = param("x", choices=_SIGNED_AXES, doc="line: its direction in the step's frame")
     distance: float = param(0.01, unit="m", gt=0.0, le=2.0, doc="line: its length")
     pitch: float = param(0.001, unit="m", gt=0.0, le=0.1, doc="spiral: radial distance between turns")
@@ -83,6 +84,17 @@ class Pattern:
     frequency: tuple[float, ...] = param((0.5, 0.7), type="floats", length=2, gt=0.0, le=5.0, unit="Hz",
                                          doc="lissajous and wiggle: (x, y) / (rx, ry)")
     duration: float = param(10.0, unit="s", gt=0.0, doc="lissajous and wiggle: where they end (pattern_done)")
+    poses: tuple[tuple[float, ...], ...] = param(
+        (), type="any", unit="m, quaternion",
+        doc="path: the tool tip's poses [x, y, z, qx, qy, qz, qw] in contact_control's fixed frame, z along "
+        "the tool's axis into the part (README, Paths at a force)")
+    forces: tuple[float, ...] = param((), type="floats", unit="N",
+                                      doc="path: the force-tracking axis's target per segment (empty: the "
+                                      "law's own)")
+    angular_speed: float = param(0.2, unit="rad/s", gt=0.0, le=2.0,
+                                 doc="path: the fastest turn between poses")
+    ramp: float = param(0.5, unit="s", ge=0.0, le=10.0, doc="path: the time to speed up at its start and to "
+                        "slow down at its end")
 
 
 @dataclass(frozen=True)
@@ -129,6 +141,7 @@ class Step:
     pattern: Pattern = field(default_factory=Pattern)
     frame: str = "tool"
     exits: tuple[Exit, ...] = ()
+    law_frame: str = "fixed"
 
 
 @dataclass(frozen=True)
@@ -139,6 +152,9 @@ class _StepKeys:
     frame: str = param("tool", choices=("tool", "fixed"), doc="the pattern's axes: the tool's at the step's "
                        "start, or contact_control's fixed frame")
     exits: list[object] = param([], type="any", doc="a list of exits (below), the first that holds is taken")
+    law_frame: str = param("fixed", choices=("fixed", "tool"),
+                           doc="the laws' axes: contact_control's control_frame, or the tool's (its "
+                           "eef_frame, turning with it: pressing along the tool's axis on a curved part)")
 
 
 @dataclass(frozen=True)
@@ -149,6 +165,7 @@ class Task:
     steps: dict[str, Step]
     start: str
     approach: str = "-z"
+    approach_frame: str = "fixed"
     surface: float | None = None
     force_ceiling: float = 25.0
     torque_ceiling: float = 2.0
@@ -166,6 +183,10 @@ class _TaskKeys:
     start: str = param("", doc="the first step (default: the first in `steps`)")
     approach: str = param("-z", choices=("x", "y", "z", "-x", "-y", "-z"), doc="the direction the tool moves "
                           "into the part, in contact_control's control frame (depth is measured along it)")
+    approach_frame: str = param("fixed", choices=("fixed", "tool"),
+                                doc="`approach` is along contact_control's control frame, or the tool's "
+                                "(as it was at the task's start; the retract then runs along the tool's "
+                                "axes)")
     surface: float | None = param(
         None, type="float", optional=True, ge=0.0, unit="m",
         doc="the part's nominal surface this far along `approach` from the tool at the task's start: depth "

@@ -11,12 +11,14 @@ from __future__ import annotations
 import difflib
 import pathlib
 from collections.abc import Mapping
+from dataclasses import replace
 
 import yaml
 from compliant_common.schema import Schema, SchemaError
 from contact_control.axes import EXCEEDED_ACTION_NAMES, LAW_NAMES
 from contact_control.request import RequestError, empty_laws_request, validate_laws_request
 
+from contact_tasks.path import PosePath
 from contact_tasks.task import (
     AXIS_NAMES,
     EXIT_SCHEMA,
@@ -45,6 +47,7 @@ _PATTERN_KEYS = {
     "spiral": ("speed", "pitch", "max_radius"),
     "lissajous": ("amplitude", "frequency", "duration"),
     "wiggle": ("amplitude", "frequency", "duration"),
+    "path": ("poses", "speed", "forces", "angular_speed", "ramp"),
 }
 _THRESHOLD_EXITS = ("force", "travel", "depth")
 
@@ -137,6 +140,7 @@ class _Parser:
             steps=steps,
             start=start,
             approach=str(keys.get("approach", "-z")),
+            approach_frame=str(keys.get("approach_frame", "fixed")),
             surface=keys.get("surface"),  # type: ignore[arg-type]
             force_ceiling=float(keys.get("force_ceiling", 25.0)),  # type: ignore[arg-type]
             torque_ceiling=float(keys.get("torque_ceiling", 2.0)),  # type: ignore[arg-type]
@@ -181,7 +185,25 @@ class _Parser:
         if pattern.type != "none" and not path_axes:
             raise _RefusedError(f"{where}pattern: a {pattern.type} pattern moves the path law's reference; "
                                 "give at least one axis law: path")
-        return Step(laws=laws, pattern=pattern, frame=str(keys.get("frame", "tool")), exits=exits)
+        if pattern.type == "path":
+            pattern = self.path(pattern, laws, where)
+        return Step(laws=laws, pattern=pattern, frame=str(keys.get("frame", "tool")), exits=exits,
+                    law_frame=str(keys.get("law_frame", "fixed")))
+
+    def path(self, pattern: Pattern, laws: Mapping[str, Law], where: str) -> Pattern:
+        """A path pattern checked: its poses make a path, one force per segment for a force-tracking axis."""
+        try:
+            path = PosePath(pattern.poses, pattern.speed, pattern.angular_speed, pattern.ramp)
+        except TaskError as err:
+            raise _RefusedError(f"{where}pattern.poses: {err}") from None
+        if pattern.forces:
+            if len(pattern.forces) != path.segments:
+                raise _RefusedError(f"{where}pattern.forces: {len(pattern.forces)} for {path.segments} "
+                                    "segments (one per segment)")
+            if not any(law.law == "force_tracking" for law in laws.values()):
+                raise _RefusedError(f"{where}pattern.forces: no axis has law: force_tracking to take them")
+        poses = tuple(tuple(float(x) for x in row) for row in pattern.poses)
+        return replace(pattern, poses=poses)
 
     def check_laws(self, laws: Mapping[str, Law], where: str) -> None:
         try:
@@ -246,10 +268,12 @@ class _Parser:
                                    f"ceiling {ceiling:g}: the ceiling fails the task first")
 
 
-def laws_request(laws: Mapping[str, Law]) -> object:
-    """A ConfigureLaws-shaped request (`contact_control.request.empty_laws_request`) of the laws; axes left
-    out are NONE. The node copies it into the genpy request field by field."""
+def laws_request(laws: Mapping[str, Law], frame: str = "") -> object:
+    """A ConfigureLaws-shaped request (`contact_control.request.empty_laws_request`) of the laws along
+    `frame` ("": contact_control's control_frame); axes left out are NONE. The node copies it into the genpy
+    request field by field."""
     req = empty_laws_request()
+    req.frame = frame
     for axis, law in laws.items():
         a = getattr(req, axis)
         a.law, a.exceeded_action = _LAW_CODES[law.law], _ACTION_CODES[law.exceeded_action]

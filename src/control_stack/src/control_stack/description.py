@@ -68,6 +68,7 @@ class ToolSpec:
         shape: "cylinder" (size: radius, length), "box" (size: x, y, z) or "sphere" (size: radius).
         size: Shape dimensions [m]; the shape starts at the sensor face and extends along +Z.
         tip_name: Name of the massless frame link at the end of the shape (the tool centre point).
+        rounded: A cylinder's end is a hemisphere of its radius (a ball-end polishing tool), same length.
     """
 
     parent: str
@@ -81,6 +82,7 @@ class ToolSpec:
     shape: str = "cylinder"
     size: tuple[float, ...] = field(default=(0.03, 0.1))
     tip_name: str = "tool_tip"
+    rounded: bool = False
 
     def validate(self) -> None:
         """Check the numbers.
@@ -100,6 +102,8 @@ class ToolSpec:
             raise DescriptionError(f"tool mass must be positive, got {self.mass}")
         if self.inertia is not None and not all(i > 0 for i in self.inertia):
             raise DescriptionError(f"tool inertia must be positive, got {self.inertia}")
+        if self.rounded and (self.shape != "cylinder" or self.size[1] < self.size[0]):
+            raise DescriptionError("a rounded end needs a cylinder at least as long as its radius")
         names = {self.ft_name, self.name, self.tip_name}
         if len(names) != 3 or "" in names:
             raise DescriptionError("sensor, tool and tip link names must be distinct and non-empty")
@@ -282,6 +286,16 @@ def _tool_links(tool: ToolSpec) -> list[ET.Element]:
     ixx, iyy, izz = tool.principal_inertia()
     ET.SubElement(inertial, "inertia", ixx=repr(ixx), iyy=repr(iyy), izz=repr(izz), ixy="0", ixz="0", iyz="0")
     for tag in ("visual", "collision"):
+        if tool.rounded:  # the shaft, and the hemisphere's ball centred one radius above the tip
+            r, length = tool.size
+            shaft = ET.SubElement(body, tag)
+            ET.SubElement(shaft, "origin", xyz=_fmt((0.0, 0.0, (length - r) / 2.0)), rpy="0 0 0")
+            shape = ET.SubElement(shaft, "geometry")
+            ET.SubElement(shape, "cylinder", radius=repr(r), length=repr(length - r))
+            ball = ET.SubElement(body, tag)
+            ET.SubElement(ball, "origin", xyz=_fmt((0.0, 0.0, length - r)), rpy="0 0 0")
+            ET.SubElement(ET.SubElement(ball, "geometry"), "sphere", radius=repr(r))
+            continue
         elem = ET.SubElement(body, tag)
         ET.SubElement(elem, "origin", xyz=_fmt(tool.centre()), rpy="0 0 0")
         elem.append(_shape_geometry(tool))
@@ -411,6 +425,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--tool-peg", type=float, default=0.0, metavar="WIDTH",
                         help="make the tool a square peg this wide [m], same length, mass and centre of mass "
                         "(contact_tasks' peg_in_hole; 0: the shape given)")
+    parser.add_argument("--tool-rounded", action="store_true",
+                        help="end the cylinder tool in a hemisphere of its radius, same length, mass and "
+                        "centre of mass (a ball-end polishing tool: curved parts)")
     return parser
 
 
@@ -428,11 +445,12 @@ def main(argv: Sequence[str] | None = None) -> int:
                 com=tuple(args.tool_com) if args.tool_com else None,
                 inertia=tuple(args.tool_inertia) if args.tool_inertia else None,
                 shape=args.tool_shape, size=tuple(args.tool_size), tip_name=args.tip_name,
+                rounded=args.tool_rounded,
             )
             if args.tool_peg > 0.0:
                 width, length = args.tool_peg, tool.length()
                 tool = dataclasses.replace(tool, shape="box", size=(width, width, length),
-                                           com=tool.com or tool.centre())
+                                           com=tool.com or tool.centre(), rounded=False)
         sys.stdout.write(build_description(text, tool, args.remove_link, erd_dir, args.robot_name))
     except DescriptionError as exc:
         sys.stderr.write(f"make_description: error: {exc}\n")

@@ -300,15 +300,16 @@ def _add_curved(world: mujoco.MjsBody, block: Box, surface: Surface) -> mujoco.M
 
 def surface_truth(block: Box, surface: Surface) -> dict[str, object]:
     """Where the finishing fixture truly is (the driver's `~surface`, for plots and tests): its kind, radius
-    [m], top [m] (a curved part's highest point; the tilted block's top face centre) and, for the tilted
-    block, its rpy [rad]."""
+    [m], top [m] (a curved part's highest point; the tilted block's top face centre), for the tilted block
+    its rpy [rad], and its friction with the tool."""
     if surface.kind == "plane":
         R = np.zeros(9)
         mujoco.mju_quat2Mat(R, rpy_to_quat(block.rpy))
         top = np.asarray(block.position) + R.reshape(3, 3)[:, 2] * block.size[2] / 2.0
-        return {"kind": "tilted", "radius": 0.0, "top": [float(x) for x in top], "rpy": list(block.rpy)}
+        return {"kind": "tilted", "radius": 0.0, "top": [float(x) for x in top], "rpy": list(block.rpy),
+                "friction": surface.friction}
     return {"kind": surface.kind, "radius": surface.radius, "top": list(surface_top(block, surface)),
-            "rpy": [0.0, 0.0, 0.0]}
+            "rpy": [0.0, 0.0, 0.0], "friction": surface.friction}
 
 
 def surface_top(block: Box, surface: Surface) -> tuple[float, float, float]:

@@ -35,7 +35,7 @@ def sim_launch(plan: Plan) -> str:
   <arg name="surface_seed" default="-1" doc="&gt;= 0: the tilted, cylinder or sphere fixture's offset drawn from this seed (each of dx, dy, dz within 10 mm)"/>
   <arg name="surface_offset" default="[0.0, 0.0, 0.0]" doc="the tilted, cylinder or sphere fixture's offset from its nominal place '[dx, dy, dz]' [m]"/>
   <arg name="hole_clearance" default="0.0004" doc="[m] the hole's width minus the peg's"/>
-  <arg name="tool" default="default" doc="peg: the tool becomes a 10 mm square peg of the same length and mass"/>
+  <arg name="tool" default="default" doc="peg: the tool becomes a 10 mm square peg of the same length and mass; ball: its end a hemisphere (curved parts)"/>
   <arg name="output" default="screen" doc="screen or log"/>
 
   <include file="$(find mujoco_driver)/launch/sim_stack.launch">
