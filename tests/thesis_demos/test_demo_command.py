@@ -99,3 +99,20 @@ def test_teach_and_replay_on_a_generated_arm(tmp_path):
     assert not (home / ".ros" / "compliant_programs").exists()
     report = (tmp_path / "out" / "report.md").read_text()
     assert "teach_and_replay.png" in report and "free space 2x: path error max [mm]" in report
+
+
+@pytest.mark.e2e  # scripts/demo runs the simulation
+def test_the_curved_surface_runs_in_its_own_scene_and_keeps_the_tool_normal(tmp_path):
+    """The eighth demonstration: make demo relaunches the UR5 over the seeded cylinder with the ball-end tool;
+    the 0.3 m path planned on the nominal cylinder is run at 10 N with the tool on the real normal."""
+    command = _demo("--robot", "ur5", "--only", "curved_surface", "--output", str(tmp_path))
+    run = _run(command, capture_output=True, text=True, timeout=300, check=False)
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    line = next(x for x in run.stdout.splitlines() if x.startswith("[PASS] curved_surface"))
+    assert line.startswith("[PASS] curved_surface: part -8.3, -5.3, +6.0 mm from nominal, not told to the "
+                           "path; 0.300 m in "), line
+    figures = {key: float(value) for key, value in re.findall(r"(force RMS error|max \|F\||true normal RMS) "
+                                                               r"([0-9.]+)", line)}
+    assert figures["force RMS error"] <= 1.5 and figures["max |F|"] <= 20.0
+    assert figures["true normal RMS"] <= 3.0
+    assert (tmp_path / "curved_surface.png").exists()

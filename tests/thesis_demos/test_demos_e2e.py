@@ -118,17 +118,20 @@ def test_surface_following_holds_the_target_force_while_x_travels(stack):
     assert verdict.passed, (robot, verdict.summary)
 
 
-def test_peg_in_hole_without_the_hole_fixture_is_named_cannot_not_failed(stack, tmp_path):
-    """run_demos against a scene without the hole (a plain sim.launch, or a real cell) says why it cannot."""
+def test_scene_demonstrations_without_their_fixture_are_named_cannot_not_failed(stack, tmp_path):
+    """run_demos against a scene without the hole or the cylinder (a plain sim.launch, or a real cell) says
+    why it cannot."""
     import subprocess
 
     robot, runner = stack
     if robot != "ur5":
         pytest.skip("the scene's fixture, not the arm, decides: one arm shows it")
-    assert not runner.has_hole()
+    assert not runner.has_hole() and not runner.has_surface("cylinder")
     run = subprocess.run(["rosrun", "thesis_demos", "run_demos", "--robot", robot, "--only", "peg_in_hole",
-                          "--output", str(tmp_path)],
+                          "curved_surface", "--output", str(tmp_path)],
                          capture_output=True, text=True, timeout=120, check=False)
     assert run.returncode == 3, run.stdout + run.stderr
     assert ("[CANNOT] peg_in_hole: this scene has no hole fixture (make demo runs it in a second launch with "
             "fixture:=hole tool:=peg") in run.stdout
+    assert ("[CANNOT] curved_surface: this scene has no cylinder (make demo runs it in a second launch with "
+            "fixture:=cylinder tool:=ball") in run.stdout

@@ -60,7 +60,8 @@ class TaskLoop(Protocol):
     busy: threading.Lock
 
     def carry_out(self, task: Task | Callable[[FloatArray], Task], preempted: Callable[[], bool],
-                  watch: Watch | None = None, feedback: Watch | None = None) -> tuple[TaskRun | None, str]: ...
+                  watch: Watch | None = None,
+                  feedback: Watch | None = None) -> tuple[TaskRun | None, str]: ...
 
     def answer(self, server: actionlib.SimpleActionServer, run: TaskRun) -> Callable[..., None]: ...
 

@@ -30,8 +30,11 @@ ORIENTATIONS = ("normal", "path", "free")
 CONTACT_FORCE = 3.0  # [N] |F| above which a sample counts as in contact (contact_control's touch force)
 _TO_START_SPEED = 0.05  # [m/s] in free space (a guess: a cautious cobot speed, within the collaborative cap)
 _TOUCH_SPEED = 0.006  # [m/s] a stiff part met faster overshoots the touch's 5 N (the wipe task's)
+_MAX_LAG = 0.05  # [m] the tool may fall this far behind the path's reference (an arm slowed by a singularity)
+_PRESS_DAMPING = 2000.0  # [N/(m/s)] force tracking's b (1000 rang between 5 and 14 N through a UR's latency)
 _CLEARANCE = 0.05  # [m] the move to the start comes along the tool's axis over this much more than standoff
 RAMP = 0.5  # [s] paths speed up and slow down over this (a speed step on a part with friction sticks)
+ARRIVE_TIME = 5.0  # [s] the tool may come to the path's end this long after its reference (a slowed arm)
 _PRESS_TIME = 2.0  # [s] the force builds and the tool turns onto the normal before it moves
 
 
@@ -85,13 +88,14 @@ def path_task(goal: PathGoal, tool: FloatArray, name: str = "follow_path") -> Ta
     standoff, far = start.copy(), start.copy()
     standoff[:3, 3] -= goal.standoff * start[:3, 2]
     far[:3, 3] -= (goal.standoff + _CLEARANCE) * start[:3, 2]
-    held = {"law": "path", "stiffness": 5.0, "max_travel": 0.02}
+    held = {"law": "path", "stiffness": 5.0, "max_travel": _MAX_LAG}
     turned = {"law": "path", "stiffness": 2.0, "max_travel": 0.3}
     free_space = {"x": held, "y": held, "z": held, "rx": turned, "ry": turned, "rz": turned}
     approach = [_pose_row(tool), _pose_row(far), _pose_row(standoff)]
     to_start = PosePath(approach, _TO_START_SPEED, 0.3, RAMP)
     # force tracking's target is the force as the sensor reads it: the part pushes the tool back along -z
-    press = {"law": "force_tracking", "target_force": -forces[0], "damping": 1000.0, "velocity": 0.005,
+    press = {"law": "force_tracking", "target_force": -forces[0], "damping": _PRESS_DAMPING,
+             "velocity": 0.005,
              "force_limit": 2.0 * top}
     normal = {"law": "normal", "stiffness": 2.0, "velocity": 0.1, "max_travel": math.pi}
     pressing = {"z": press} if goal.orientation == "path" else {"z": press, "rx": normal, "ry": normal}
@@ -132,7 +136,11 @@ def path_task(goal: PathGoal, tool: FloatArray, name: str = "follow_path") -> Ta
                 "pattern": {"type": "path", "poses": [list(map(float, row)) for row in goal.poses],
                             "speed": goal.speed, "forces": [-f for f in forces], "ramp": RAMP},
                 "exits": [{"when": "pattern_done", "succeed": f"ran the path's {path.length:.3f} m"},
-                          {"when": "move_ended", "fail": "contact_control ended the move along the path"}]},
+                          {"when": "move_ended", "fail": "contact_control ended the move along the path"},
+                          {"when": "timeout", "after": path.duration + ARRIVE_TIME,
+                           "fail": f"the tool was not at the path's end {ARRIVE_TIME:g} s after its "
+                           "reference (an arm slowed near a singularity or a joint limit: jog_arm's "
+                           "~status)"}]},
         },
     }
     return parse_task(data, "<follow_path goal>")

@@ -25,6 +25,7 @@ from contact_tasks.task_file import laws_request
 __all__ = ["CANCELLED", "FAILED", "RUNNING", "SUCCEEDED", "Command", "Observation", "TaskRun"]
 
 RUNNING, SUCCEEDED, FAILED, CANCELLED = "running", "succeeded", "failed", "cancelled"
+ARRIVED = 0.002  # [m] a path's end is reached this close to its last pose, across the tool's axis
 _RETRACT = "retract"  # the built-in on-failure step's name in results
 _DIRECTIONS = {"x": 0, "y": 1, "z": 2}
 
@@ -175,7 +176,7 @@ class TaskRun:
             return self._fail(f"in step '{self.step_name}': the task ran longer than its time limit "
                               f"{task.time_limit:g} s", obs)
         step_t = obs.t - self._step_t
-        point = self._point(step_t)
+        point = self._point(step_t, obs.tool)
         self.search_radius = point.radius
         for i, ex in enumerate(self._step.exits):
             if self._holds(i, ex, obs, step_t, point):
@@ -207,20 +208,27 @@ class TaskRun:
         if pattern.type == "path":
             self._path = PosePath(pattern.poses, pattern.speed, pattern.angular_speed, pattern.ramp)
         self.path_point, self._force = None, math.nan
-        reference = self._reference(self._point(0.0), 0.0) if _has_path(step) else None
+        reference = self._reference(self._point(0.0, obs.tool), 0.0) if _has_path(step) else None
         laws = self._segment_laws() or laws_request(step.laws, self._law_frame(step))
         return Command(name, laws=laws, restart=restart, reference=reference)
 
     def _law_frame(self, step: Step) -> str:
         return self.tool_frame if step.law_frame == "tool" else ""
 
-    def _point(self, step_t: float) -> PatternPoint:
-        """The step's pattern at `step_t`; a path's also in `path_point`."""
+    def _point(self, step_t: float, tool: FloatArray) -> PatternPoint:
+        """The step's pattern at `step_t`; a path's also in `path_point`. A path is done once its reference
+        ended and the tool has come within ARRIVED of its end across its axis (a part off its nominal place
+        moves the end along the axis): give its step a timeout exit for a tool that never gets there."""
         assert self._step is not None
         if self._path is None:
             return evaluate(self._step.pattern, step_t)
         p = self.path_point = self._path.at(step_t)
-        return PatternPoint((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0,) * 6, p.done, p.arc)
+        done = p.done
+        if done:
+            off = np.asarray(p.position) - tool[:3, 3]
+            axis = tool[:3, 2]
+            done = float(np.linalg.norm(off - (off @ axis) * axis)) <= ARRIVED
+        return PatternPoint((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0,) * 6, done, p.arc)
 
     def _segment_laws(self) -> object | None:
         """The step's laws with the force of the path's segment when it changed (a bumpless change in

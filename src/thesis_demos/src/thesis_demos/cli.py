@@ -53,6 +53,16 @@ def _args(argv: Sequence[str]) -> argparse.Namespace:
     return parser.parse_args(argv)
 
 
+def _path_cannot(runner: Any, setup: Any) -> str:
+    """Why the curved demonstration cannot run here ("" if it can): no nominal part, or no cylinder."""
+    if setup.obstacle is None:
+        return "the robot package's scene has no obstacle, whose top is the curved part's nominal place"
+    if not runner.has_surface("cylinder"):
+        return ("this scene has no cylinder (make demo runs it in a second launch with "
+                "fixture:=cylinder tool:=ball and a surface_seed)")
+    return ""
+
+
 def unresolvable(scenario: Any, floor: NoiseFloor | None, sigmas: float,
                  global_force: float = ContactControlSettings.global_max_force,
                  pose: tuple[float, float] = (0.0, 0.0)) -> str:
@@ -102,9 +112,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     argv = rospy.myargv(sys.argv if argv is None else list(argv))[1:]
     args = _args(argv)
     from thesis_demos.analysis import Verdict, judge
+    from thesis_demos.finishing import judge_path
     from thesis_demos.geometry import DemoConfigError, robot_setup
     from thesis_demos.insertion import judge_task
-    from thesis_demos.plotting import plot, plot_task
+    from thesis_demos.path_client import PathFlow
+    from thesis_demos.plotting import plot, plot_path, plot_task
     from thesis_demos.report import markdown
     from thesis_demos.runner import DemoRunner, Names
     from thesis_demos.scenarios import by_name, fitted
@@ -146,6 +158,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         if scenario.task is not None and not runner.has_hole():
             reason = ("this scene has no hole fixture (make demo runs it in a second launch with "
                       f"{' '.join(f'{k}:={v}' for k, v in scenario.scene)})")
+        if scenario.path is not None and not reason:
+            reason = _path_cannot(runner, setup)
         if reason:  # the sensor cannot tell this demonstration's force limit from its noise
             cannot[scenario.name] = reason
             print(f"[CANNOT] {scenario.name}: {reason}", flush=True)
@@ -157,6 +171,11 @@ def main(argv: Sequence[str] | None = None) -> int:
                 done = TaskFlow(runner, args.tasks, nominal).run(scenario.task, args.sensor_frame)
                 verdict = judge_task(scenario.task, done)
                 plot_task(scenario, done, verdict, os.path.join(args.output, png))
+            elif scenario.path is not None and setup.obstacle is not None:
+                flow = PathFlow(runner, args.tasks, setup.obstacle.top_centre)
+                ran = flow.run(scenario.path, args.sensor_frame)
+                verdict = judge_path(scenario.path, ran)
+                plot_path(scenario, ran, verdict, os.path.join(args.output, png))
             else:
                 recording = runner.run(scenario, args.sensor_frame)
                 verdict = judge(scenario, recording)

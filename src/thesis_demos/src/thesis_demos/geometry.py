@@ -100,6 +100,9 @@ class DemoGeometry:
             thesis's 0.5 N).
         driver_force_limits: (driver profile, limit [N]) pairs: the limit with that driver's sensor
             (`make demo DRIVER=...`), which resolves less than the simulation's wrist sensor.
+        curved_middle: The curved demonstration's path middle, from the cylinder's top toward +X [rad]
+            (signed: an arm that nears a singularity on one side runs the path more on the other).
+        curved_length: Its length [m] (the tool turns length / 0.25 rad along it).
     """
 
     follower_push_force: float = 5.0
@@ -114,6 +117,8 @@ class DemoGeometry:
     hybrid_travel: float = 0.30
     contact_force_limit: float = 0.5
     driver_force_limits: tuple[tuple[str, float], ...] = ()
+    curved_middle: float = 0.0
+    curved_length: float = 0.3
 
     def for_driver(self, driver: str) -> DemoGeometry:
         """These numbers with the force limit for `driver`'s sensor ("" or not listed: unchanged)."""
@@ -139,6 +144,7 @@ class DemoGeometry:
             },
             "spring": {"direction": "spring_direction", "push_force": "spring_push_force"},
             "hybrid": {"direction": "hybrid_direction", "speed": "hybrid_speed", "travel": "hybrid_travel"},
+            "curved_surface": {"middle": "curved_middle", "length": "curved_length"},
         }
         unknown = set(data) - set(layout) - {"contact_force"}
         if unknown:
@@ -158,7 +164,12 @@ class DemoGeometry:
                 name = f"{section}.{key}"
                 if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                     raise DemoConfigError(f"{name}: expected a number, got {value!r}")
-                if key == "direction":
+                if key == "middle":
+                    if abs(value) > 1.0:
+                        raise DemoConfigError(f"{name}: expected an angle within 1 rad of the top, got "
+                                              f"{value!r}")
+                    values[attr] = float(value)
+                elif key == "direction":
                     if value not in (-1, 1):
                         raise DemoConfigError(f"{name}: expected -1 or 1, got {value!r}")
                     values[attr] = int(value)
@@ -177,6 +188,11 @@ class DemoGeometry:
             out["contact_force"]["drivers"] = dict(self.driver_force_limits)
         prefixes = {"follower_": "follower", "compliant_": "compliant_move", "spring_": "spring",
                     "hybrid_": "hybrid"}
+        curved = {k: v for k, v, default in (("middle", self.curved_middle, 0.0),
+                                             ("length", self.curved_length, DemoGeometry.curved_length))
+                  if v != default}  # only when set: most arms run 0.3 m centred on the top
+        if curved:
+            out["curved_surface"] = curved
         for f in fields(self):
             for prefix, section in prefixes.items():
                 if f.name.startswith(prefix):
@@ -198,6 +214,11 @@ class Obstacle:
     @property
     def bottom(self) -> float:
         return self.position[2] - self.size[2] / 2.0
+
+    @property
+    def top_centre(self) -> tuple[float, float, float]:
+        """The centre of its top face [m] (where mujoco_driver's curved parts have their highest point)."""
+        return (self.position[0], self.position[1], self.top)
 
     def covers(self, x: float, y: float, inset: float = 0.0) -> bool:
         """True if (x, y) lies over the box's footprint, at least `inset` inside its edges."""

@@ -10,10 +10,11 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from thesis_demos.analysis import AXIS_INDEX, Recording, Verdict
+from thesis_demos.finishing import PathRecording
 from thesis_demos.insertion import TaskRecording
 from thesis_demos.scenarios import SURFACE_TOLERANCE, Scenario
 
-__all__ = ["plot", "plot_task"]
+__all__ = ["plot", "plot_path", "plot_task"]
 
 PEG_HALF = 0.005  # [m] the peg tool's half width (mujoco_driver tool:=peg)
 
@@ -144,3 +145,43 @@ def plot_task(scenario: Scenario, rec: TaskRecording, verdict: Verdict, path: st
     ax_d.set_ylabel("depth past the touch [mm]")
     ax_d.set_xlabel("time since the task began [s]")
     _finish(fig, (ax_xy, ax_f, ax_d), scenario, verdict, path)
+
+
+def plot_path(scenario: Scenario, rec: PathRecording, verdict: Verdict, path: str) -> None:
+    """Curved surface: the path seen from the side over the real and the nominal cylinder, then the force
+    along the tool's axis and the tool's angle to the normal along the path."""
+    from thesis_demos.finishing import true_angles
+
+    fig, (ax_side, ax_f, ax_a) = plt.subplots(3, 1, figsize=(9, 10), gridspec_kw={"height_ratios": [3, 2, 2]})
+    demo = scenario.path
+    radius = demo.radius if demo is not None else 0.25
+    arc = np.linspace(-1.0, 1.0, 200)
+    for top, style, label in ((rec.nominal_top, "--", "the cylinder as planned"),
+                              (rec.truth["top"] if rec.truth else None, "-", "the cylinder (true place)")):
+        if top is not None:
+            x = top[0] + radius * np.sin(arc)
+            z = top[2] - radius + radius * np.cos(arc)
+            ax_side.plot(x * 1e3, z * 1e3, style, color="black" if style == "-" else "grey", label=label)
+    if len(rec.planned):
+        ax_side.plot(rec.planned[:, 0] * 1e3, rec.planned[:, 2] * 1e3, ".", color="grey", markersize=3,
+                     label="the planned path")
+    if len(rec.tip):
+        ax_side.plot(rec.tip[:, 0] * 1e3, rec.tip[:, 2] * 1e3, linewidth=1.5, label="tool tip")
+    target = demo.force if demo is not None else 10.0
+    ax_f.plot(rec.progress * 100.0, rec.force, ".", markersize=3, label="along the tool's axis")
+    ax_f.axhline(target, color="black", linewidth=1)
+    ax_f.axhspan(target - (demo.force_rms if demo else 1.5), target + (demo.force_rms if demo else 1.5),
+                 color="green", alpha=0.1)
+    angles = true_angles(rec)
+    if len(angles) and len(rec.pose_t) == len(angles):
+        progress = np.interp(rec.pose_t, rec.feedback_t, rec.progress) if len(rec.feedback_t) else rec.pose_t
+        ax_a.plot(progress * 100.0, angles, linewidth=1, label="to the true normal under the tip")
+    ax_a.plot(rec.progress * 100.0, rec.angle, ".", markersize=3, label="to the normal the force reads")
+    ax_a.axhline(demo.angle_max if demo else 8.0, color="red", linestyle="--", linewidth=1)
+    ax_side.set_aspect("equal", adjustable="datalim")
+    ax_side.set_xlabel("x [mm]")
+    ax_side.set_ylabel("z [mm]")
+    ax_f.set_ylabel("force [N]")
+    ax_a.set_ylabel("tool's axis to the normal [deg]")
+    ax_a.set_xlabel("along the path [%]")
+    _finish(fig, (ax_side, ax_f, ax_a), scenario, verdict, path)

@@ -1,5 +1,6 @@
-"""The four thesis demonstrations, a fifth (surface following), a sixth (teach and replay) and a seventh (peg
-in hole, a contact_tasks task) as data: laws, pushes, what to judge.
+"""The four thesis demonstrations, a fifth (surface following), a sixth (teach and replay), a seventh (peg in
+hole, a contact_tasks task) and an eighth (a path at a force over a curved part) as data: laws, pushes, what
+to judge.
 
 Pure: no rospy. Forces are in the robot's base frame [N]; velocities [m/s]; distances [m].
 """
@@ -12,8 +13,8 @@ from dataclasses import dataclass, field
 
 from thesis_demos.geometry import SURFACE_DIRECTION, SURFACE_TRAVEL, DemoGeometry, RobotSetup, fit_l
 
-__all__ = ["SCENARIOS", "AxisLaw", "FollowUp", "Push", "Scenario", "TaskDemo", "TeachL", "build_scenarios",
-           "by_name", "fitted", "peg_in_hole"]
+__all__ = ["SCENARIOS", "AxisLaw", "FollowUp", "PathDemo", "Push", "Scenario", "TaskDemo", "TeachL",
+           "build_scenarios", "by_name", "curved_surface", "fitted", "peg_in_hole"]
 
 AXES = ("x", "y", "z", "rx", "ry", "rz")
 # cartesian_impedance_msgs/ControlLaw
@@ -91,6 +92,28 @@ class TaskDemo:
 
 
 @dataclass(frozen=True)
+class PathDemo:
+    """A path at a force over a curved part (contact_tasks' ~follow_path), the scene it needs and its bounds.
+
+    The path is planned on the nominal cylinder (axis along y, `radius`, its top at the obstacle's top
+    centre), `middle` [rad] from the top toward +x; the scene's cylinder is off that by a seeded offset.
+    """
+
+    scene: tuple[tuple[str, str], ...]
+    radius: float = 0.25  # [m] mujoco_driver's cylinder
+    length: float = 0.3  # [m]
+    speed: float = 0.02  # [m/s]
+    force: float = 10.0  # [N]
+    middle: float = 0.0  # [rad]
+    force_rms: float = 1.5  # [N] RMS of the force along the tool's axis minus the target, at most
+    force_max: float = 20.0  # [N] |F| at most
+    contact: float = 0.98  # of the path in contact (> 3 N) at least
+    angle_rms: float = 3.0  # [deg] the tool's axis to the normal, RMS at most
+    angle_max: float = 8.0  # [deg]
+    lateral: float = 0.002  # [m] sideways from the path at most
+
+
+@dataclass(frozen=True)
 class Scenario:
     """A demonstration: laws, pushes, how long to record, and the axes that matter."""
 
@@ -109,11 +132,14 @@ class Scenario:
     teach: TeachL | None = None  # the L taught by hand (its own flow: thesis_demos.teach_client)
     press_force: float = 0.0  # [N] force tracking's target on a pressed replay (0: none)
     task: TaskDemo | None = None  # a contact_tasks task in a scene of its own (its own flow: task_client)
+    path: PathDemo | None = None  # a path at a force in a scene of its own (its own flow: path_client)
 
     @property
     def scene(self) -> tuple[tuple[str, str], ...]:
         """The sim.launch arguments this demonstration needs beyond the robot package's scene."""
-        return self.task.scene if self.task is not None else ()
+        if self.task is not None:
+            return self.task.scene
+        return self.path.scene if self.path is not None else ()
 
     @property
     def uses_laws_service(self) -> bool:
@@ -206,6 +232,7 @@ def build_scenarios(geometry: DemoGeometry | None = None) -> tuple[Scenario, ...
         surface_following(),
         teach_and_replay(),
         peg_in_hole(),
+        curved_surface(g.curved_middle, g.curved_length),
     )
 
 
@@ -312,6 +339,28 @@ def peg_in_hole() -> Scenario:
         duration=45.0,
         controlled=("x", "y", "z"),
         task=TaskDemo("peg_in_hole", scene),
+    )
+
+
+# A curved part (the eighth demonstration): mujoco_driver's cylinder drawn from a seed within 10 mm of its
+# nominal place (surface_seed), the ball-end tool (a flat face bears on its edge on a convex part:
+# contact_tasks' README, Paths at a force).
+CURVED_SEED = 3
+
+
+def curved_surface(middle: float = 0.0, length: float = 0.3) -> Scenario:
+    """The eighth demonstration (not in the thesis): a 0.3 m path over a cylinder at 20 mm/s pressing 10 N,
+    planned on the nominal cylinder, run on the offset one (`middle`, `length`: the arm's, demos.yaml)."""
+    scene = (("fixture", "cylinder"), ("tool", "ball"), ("surface_seed", str(CURVED_SEED)))
+    demo = PathDemo(scene, length=length, middle=middle)
+    return Scenario(
+        name="curved_surface",
+        title=f"Curved surface: a {demo.length:g} m path over a {demo.radius:g} m cylinder off its nominal "
+        f"place at {demo.speed * 1e3:g} mm/s pressing {demo.force:g} N, the tool kept normal",
+        laws={},
+        duration=demo.length / demo.speed + 40.0,
+        controlled=("x", "z", "ry"),
+        path=demo,
     )
 
 

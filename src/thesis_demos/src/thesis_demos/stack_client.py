@@ -285,6 +285,11 @@ class StackClient:
         """Whether the simulated scene has the hole fixture (the driver's ground truth `~hole_pose`)."""
         return rospy.has_param(f"{self.names.driver}/hole_pose")
 
+    def has_surface(self, kind: str) -> bool:
+        """Whether the simulated scene has a finishing fixture of `kind` (the driver's `~surface`)."""
+        truth = rospy.get_param(f"{self.names.driver}/surface", None)
+        return isinstance(truth, dict) and truth.get("kind") == kind
+
     def contact_setting(self, name: str) -> float:
         """contact_control's parameter `name` as the node reads it (its default if unset)."""
         default = getattr(ContactControlSettings, name)
