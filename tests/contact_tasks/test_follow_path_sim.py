@@ -1,7 +1,7 @@
-"""End to end: task_server's ~follow_path on the simulated UR5 with a ball-end tool over a cylinder that is
-not where the path was planned: a 0.3 m path over the nominal cylinder's top at 20 mm/s pressing 10 N,
-given as a nav_msgs/Path in another tf frame. The result's figures, and the tool's axis against the
-driver's ground truth of the cylinder; a goal that cannot be run is refused and nothing moves."""
+"""End to end: task_server's ~follow_path on the simulated UR5 with a ball-end tool over parts that are not
+where the paths were planned: a 0.3 m path over the nominal cylinder's top at 20 mm/s pressing 10 N, given as
+a nav_msgs/Path in another tf frame, and 80 mm down the tilted plane. The results' figures, and the tool's
+axis against the driver's ground truth; a goal that cannot be run is refused and nothing moves."""
 
 from __future__ import annotations
 
@@ -126,3 +126,51 @@ def test_a_path_over_an_offset_cylinder_is_run_at_10_n_with_the_tool_normal(ros_
     centre = np.asarray(truth["top"]) - (0.0, 0.0, RADIUS)
     over = math.atan2(end[0] - centre[0], end[2] - centre[2])  # where the tool ended on the real cylinder
     assert over == pytest.approx(MIDDLE + 0.6, abs=0.03)  # the path's end, 0.15 m of arc past its middle
+
+
+def test_a_path_down_a_tilted_plane_keeps_the_force_along_the_tool_and_the_tool_normal(ros_node):
+    """The driver's `tilted` block (15 degrees about y, 4/-3/6 mm off): an 80 mm path down its slope planned
+    on the nominal plane, pressing 8 N, with the tool on the plane's normal throughout."""
+    tilt, offset = 0.2618, (0.004, -0.003, 0.006)
+    slope = np.array([[math.cos(tilt), 0.0, math.sin(tilt)], [0.0, 1.0, 0.0],
+                      [-math.sin(tilt), 0.0, math.cos(tilt)]])  # turned about y
+    centre = np.array([0.60, 0.109, 0.065]) + slope @ (0.0, 0.0, 0.065)  # ur5_custom's block, top face centre
+    along = slope[:, 0]
+    turned = slope @ DOWN
+    quaternion = matrix_quaternion(turned.tolist())
+    planned = [[*(centre + s * along), *quaternion] for s in np.linspace(-0.04, 0.04, 9)]
+    args = {"fixture": "tilted", "tool": "ball", "surface_offset": f"[{offset[0]}, {offset[1]}, {offset[2]}]"}
+    with task_stack(args) as (h, _client, _tool):
+        assert rospy.ServiceProxy("/named_poses/move_to", MoveToNamedPose)(name="start").success
+        truth = rospy.get_param("/mujoco_driver/surface")
+        assert truth["kind"] == "tilted"
+        dynamic_reconfigure.client.Client("/contact_control_node", timeout=20).update_configuration(
+            {"normal_friction": truth["friction"]})
+        client = actionlib.SimpleActionClient("/task_server/follow_path", FollowPathAtForceAction)
+        assert client.wait_for_server(rospy.Duration(30.0))
+        goal = FollowPathAtForceGoal(speed=0.01, force=8.0)
+        goal.poses.header.frame_id = "base_link"
+        goal.poses.poses = [_pose(row) for row in planned]
+        pose = Collector("/mujoco_driver/eef_pose", PoseStamped)
+        following: list[float] = []
+        try:
+            client.send_goal(goal, feedback_cb=lambda f: following.append(rospy.get_time())
+                             if f.step == "follow" else None)
+            assert client.wait_for_result(rospy.Duration(90.0))
+            result = client.get_result()
+        finally:
+            pose.close()
+        h.stop()
+    print(f"\nfollow_path (tilted): {result.outcome}: {result.message}; force RMS error "
+          f"{result.force_rms_error:.2f} N, max {result.force_max:.1f} N, contact "
+          f"{result.contact_fraction:.3f}, angle (force) RMS {result.normal_angle_rms:.2f} deg, lateral max "
+          f"{result.lateral_error_max * 1e3:.2f} mm")
+    assert result.success, result.message
+    assert result.force_rms_error <= 1.5 and result.force_max <= 16.0 and result.contact_fraction >= 0.98
+    assert result.lateral_error_max <= 0.002
+    normal = slope[:, 2]  # the plane's normal (an offset moves the plane, it does not turn it)
+    angles = np.array([math.degrees(math.acos(float(np.clip(-_tip_and_axis(m)[1] @ normal, -1.0, 1.0))))
+                       for m in pose.msgs if following[0] < m.header.stamp.to_sec() < following[-1]])
+    rms = math.sqrt(float(np.mean(angles**2)))
+    print(f"tool's axis to the plane's normal: RMS {rms:.2f}, max {angles.max():.2f} deg")
+    assert len(angles) > 100 and rms <= 3.0 and angles.max() <= 8.0
