@@ -21,8 +21,8 @@ def _run(goal: PathGoal, start=(0.0, 0.0, 0.03)) -> tuple[TaskLoop, object, Path
     tool = tool_down(*start)
     run = TaskRun(path_task(goal, tool), horizon=0.4, tool_frame="tool_tip")
     loop = TaskLoop(run, HoleWorld(**PLATE), tool)
-    forces = list(goal.forces) or [goal.force] * (len(goal.poses) - 1)
-    metrics = PathMetrics(PosePath(goal.poses, goal.speed), forces)
+    path = PosePath(goal.poses, goal.speed)
+    metrics = PathMetrics(path, goal.segment_forces(path.segments))
 
     def watch(run: TaskRun, obs) -> None:
         if run.step_name == "follow" and run.path_point is not None and run.running:

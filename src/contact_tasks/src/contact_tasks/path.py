@@ -16,6 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from compliant_common.typedefs import FloatArray
+from contact_control.frames import quaternion_matrix, times_transpose
+from contact_control.travel import rotation_vector
 
 from contact_tasks.task import TaskError
 
@@ -47,25 +49,9 @@ def quaternion_slerp(a: FloatArray, b: FloatArray, u: float) -> FloatArray:
     return (math.sin((1.0 - u) * theta) * a + math.sin(u * theta) * b) / math.sin(theta)
 
 
-def _angle(a: FloatArray, b: FloatArray) -> float:
-    return 2.0 * math.acos(min(1.0, abs(float(a @ b))))
-
-
-def _rotvec(a: FloatArray, b: FloatArray) -> FloatArray:
-    """The rotation vector (fixed frame) that turns orientation `a` into `b`: b = r * a."""
-    ax, ay, az, aw = -a[0], -a[1], -a[2], a[3]  # a's inverse
-    bx, by, bz, bw = b
-    # r = b * a^-1 (Hamilton product)
-    x = bw * ax + bx * aw + by * az - bz * ay
-    y = bw * ay - bx * az + by * aw + bz * ax
-    z = bw * az + bx * ay - by * ax + bz * aw
-    w = bw * aw - bx * ax - by * ay - bz * az
-    if w < 0.0:
-        x, y, z, w = -x, -y, -z, -w
-    s = math.sqrt(x * x + y * y + z * z)
-    if s < 1e-12:
-        return np.zeros(3)
-    return np.array([x, y, z]) * (2.0 * math.atan2(s, w) / s)
+def _turn(a: FloatArray, b: FloatArray) -> FloatArray:
+    """The rotation vector (fixed frame) that turns orientation `a` into `b` (quaternions): R_b R_a^T."""
+    return np.asarray(rotation_vector(times_transpose(quaternion_matrix(*b), quaternion_matrix(*a))))
 
 
 class PosePath:
@@ -99,7 +85,8 @@ class PosePath:
                 quats[i] = -quats[i]
         self.quaternions = quats
         self.lengths = np.linalg.norm(np.diff(self.positions, axis=0), axis=1)
-        turns = np.array([_angle(quats[i], quats[i + 1]) for i in range(len(quats) - 1)])
+        spins = [_turn(quats[i], quats[i + 1]) for i in range(len(quats) - 1)]
+        turns = np.array([float(np.linalg.norm(w)) for w in spins])
         still = np.flatnonzero((self.lengths < 1e-9) & (turns < 1e-9))
         if still.size:
             raise TaskError(f"path poses {int(still[0])} and {int(still[0]) + 1} are the same")
@@ -110,7 +97,7 @@ class PosePath:
         self._nominal = float(self.starts[-1])  # at full speed throughout
         self.ramp = min(max(ramp, 0.0), self._nominal)
         self.duration = self._nominal + self.ramp
-        self._spin = [_rotvec(quats[i], quats[i + 1]) / self.durations[i] for i in range(len(quats) - 1)]
+        self._spin = [w / d for w, d in zip(spins, self.durations, strict=True)]
 
     @property
     def segments(self) -> int:

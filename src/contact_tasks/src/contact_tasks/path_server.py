@@ -116,10 +116,10 @@ class FollowPathServer:
                             forces=tuple(goal.segment_forces), orientation=goal.orientation or "normal",
                             standoff=goal.standoff or 0.02)
             task = path_task(want, tool)
-            forces = list(want.forces) or [want.force] * (len(want.poses) - 1)
+            path = PosePath(want.poses, want.speed, ramp=RAMP)
             # the friction contact_control's normal law takes out (live-tunable: read per goal)
             mu = float(rospy.get_param(self._node.cc + "/normal_friction", 0.0))
-            measured.append(PathMetrics(PosePath(want.poses, want.speed, ramp=RAMP), forces, mu))
+            measured.append(PathMetrics(path, want.segment_forces(path.segments), mu))
             return task
 
         latest = [0.0, 0.0, 0.0]  # force, path error, angle of the last sample along the path

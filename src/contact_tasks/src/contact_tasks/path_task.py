@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from compliant_common.typedefs import FloatArray
-from contact_control.frames import matrix_quaternion, quaternion_matrix
+from contact_control.frames import matrix_quaternion, transform
 from contact_control.normal import SLIP_SPEED
 
 from contact_tasks.path import PosePath
@@ -50,16 +50,13 @@ class PathGoal:
     orientation: str = "normal"
     standoff: float = 0.02
 
+    def segment_forces(self, segments: int) -> list[float]:
+        """The pressing force of each of `segments` segments [N]: `forces`, else `force` throughout."""
+        return [float(f) for f in self.forces] or [float(self.force)] * segments
+
 
 def _pose_row(T: FloatArray) -> list[float]:
     return [*(float(x) for x in T[:3, 3]), *matrix_quaternion(T[:3, :3].tolist())]
-
-
-def _pose_matrix(row: Sequence[float]) -> FloatArray:
-    T = np.eye(4)
-    T[:3, :3] = quaternion_matrix(*row[3:7])
-    T[:3, 3] = row[:3]
-    return T
 
 
 def path_task(goal: PathGoal, tool: FloatArray, name: str = "follow_path") -> Task:
@@ -78,13 +75,13 @@ def path_task(goal: PathGoal, tool: FloatArray, name: str = "follow_path") -> Ta
         path = PosePath(goal.poses, goal.speed, ramp=RAMP)
     except TaskError as err:
         raise TaskError(f"path: {err}") from None
-    forces = [float(f) for f in goal.forces] or [float(goal.force)] * path.segments
+    forces = goal.segment_forces(path.segments)
     if len(forces) != path.segments:
         raise TaskError(f"segment_forces: {len(forces)} for {path.segments} segments (one per segment)")
     if not all(0.5 <= f <= 100.0 for f in forces):
         raise TaskError(f"force: {min(forces):g}..{max(forces):g} N is outside 0.5..100 N")
     top = max(forces)
-    start = _pose_matrix(path.positions[0].tolist() + path.quaternions[0].tolist())
+    start = np.asarray(transform(path.positions[0], path.quaternions[0]))
     standoff, far = start.copy(), start.copy()
     standoff[:3, 3] -= goal.standoff * start[:3, 2]
     far[:3, 3] -= (goal.standoff + _CLEARANCE) * start[:3, 2]
