@@ -5,6 +5,8 @@ ROBOT ?= ur5
 DRIVER ?=
 DRIVER_OPTIONS ?=
 HARDWARE_ARGS ?=
+# The ROS master of a driver that runs already, e.g. on the robot's computer (README, Two computers).
+MASTER ?=
 BAG ?=
 ENV := scripts/with_env
 PYTEST_ARGS ?=
@@ -45,7 +47,8 @@ param-tables: build
 demo: build
 	@$(ENV) python scripts/demo --robot $(ROBOT) $(if $(DRIVER),--driver $(DRIVER)) \
 		$(if $(DRIVER_OPTIONS),--driver-options "$(DRIVER_OPTIONS)") \
-		$(if $(HARDWARE_ARGS),--hardware-args "$(HARDWARE_ARGS)") $(if $(BAG),--bag)
+		$(if $(HARDWARE_ARGS),--hardware-args "$(HARDWARE_ARGS)") $(if $(BAG),--bag) \
+		$(if $(MASTER),--master "$(MASTER)")
 
 # make robot NAME=<name> URDF=<path, or relative to example-robot-data's robots/> TIP=<flange link>
 #   [BASE=<link>] [TOOL_MASS=<kg>] [TOOL_RPY=<roll,pitch,yaw>] [HELD=<joint=position,...>]
