@@ -12,6 +12,7 @@ import threading
 import rospy
 import tf2_ros
 import yaml
+from compliant_common.ros_tf_prefix import for_this_node
 from compliant_common.ros_time import timer
 from compliant_control_msgs.msg import ContactControlStatus, JogStatus, PathReference
 from geometry_msgs.msg import Point, WrenchStamped
@@ -36,10 +37,12 @@ class StackMarkers:
     """Subscribers, tf and the timer that publishes the markers."""
 
     def __init__(self) -> None:
-        cc = rospy.get_param("~contact_control", "/contact_control_node").rstrip("/")
-        jog = rospy.get_param("~jog_arm", "/jog_arm_server").rstrip("/")
-        self.base = rospy.get_param("~base_frame", rospy.get_param(f"{cc}/fixed_frame", "base_link"))
-        self.tip = rospy.get_param("~tip_frame", rospy.get_param(f"{cc}/eef_frame", "tool0"))
+        cc = rospy.get_param("~contact_control", "contact_control_node").rstrip("/")
+        jog = rospy.get_param("~jog_arm", "jog_arm_server").rstrip("/")
+        prefix = for_this_node()  # the robot's links on tf
+        base = rospy.get_param("~base_frame", rospy.get_param(f"{cc}/fixed_frame", "base_link"))
+        self.base = prefix.add(base)
+        self.tip = prefix.add(rospy.get_param("~tip_frame", rospy.get_param(f"{cc}/eef_frame", "tool0")))
         self._lock = threading.Lock()
         self._status: ContactControlStatus | None = None
         self._jog: JogStatus | None = None
@@ -47,7 +50,7 @@ class StackMarkers:
         self._reference = Trail()
         self._tool = Trail()
         self._last_reference = -1e9
-        scene = rospy.get_param("~scene_config", rospy.get_param("/mujoco_driver/scene_config", ""))
+        scene = rospy.get_param("~scene_config", rospy.get_param("mujoco_driver/scene_config", ""))
         self._box = self._scene_box(scene)
         self._tf = tf2_ros.Buffer()
         self._listener = tf2_ros.TransformListener(self._tf)
@@ -56,7 +59,7 @@ class StackMarkers:
             rospy.Subscriber(f"{cc}/status", ContactControlStatus, self._on_status, queue_size=1),
             rospy.Subscriber(f"{cc}/path_reference", PathReference, self._on_reference, queue_size=10),
             rospy.Subscriber(f"{jog}/status", JogStatus, self._on_jog, queue_size=1),
-            rospy.Subscriber(rospy.get_param("~push_topic", "/mujoco_driver/active_push"), WrenchStamped,
+            rospy.Subscriber(rospy.get_param("~push_topic", "mujoco_driver/active_push"), WrenchStamped,
                              self._on_push, queue_size=1),
         ]
         self._timer = timer(1.0 / float(rospy.get_param("~rate", 10.0)), self._tick)

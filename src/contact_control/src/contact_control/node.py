@@ -15,6 +15,7 @@ from collections.abc import Sequence
 import rospy
 from compliant_common.clock import ClockJump
 from compliant_common.ros_master import MasterWatch
+from compliant_common.ros_tf_prefix import for_this_node
 from compliant_common.ros_ticker import start_ticker
 from compliant_common.ros_time import JumpAwareClock
 from compliant_common.runtime import tune_runtime
@@ -36,7 +37,7 @@ class ContactControlNode:
         s = settings
         self._lock = threading.Lock()
         self._clock = JumpAwareClock()
-        tf = TfPoses(s.fixed_frame)
+        tf = TfPoses(s.fixed_frame, for_this_node())
         self.stage = ContactStage(settings, tf)
         if self.stage.frames_used:
             tf.listen()
@@ -60,7 +61,7 @@ class ContactControlNode:
         if self.ros.payload.sampling:
             self.ros.payload.feed(wrench)
         with self._lock:
-            self.ros.send(self.stage.on_wrench(wrench, msg.header.frame_id, stamp, t), t)
+            self.ros.send(self.stage.on_wrench(wrench, self.ros.tf.bare(msg.header.frame_id), stamp, t), t)
             self.stage.update_contact()  # after the twist: off its path
             self.ros.send_contact()
             self.ros.after()

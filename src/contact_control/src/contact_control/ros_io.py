@@ -23,7 +23,9 @@ from cartesian_impedance_msgs.srv import (
 from compliant_common.diagnostics import Report
 from compliant_common.ros_diagnostics import DiagnosticsPublisher
 from compliant_common.ros_live_params import LiveParams
+from compliant_common.ros_tf_prefix import for_this_node
 from compliant_common.ros_time import TimerEvent, timer
+from compliant_common.tf_prefix import TfPrefix
 from compliant_control_msgs.msg import AxisState, ContactControlStatus, ContactEvent, PathReference
 from compliant_control_msgs.srv import (
     ConfigureLaws,
@@ -66,8 +68,9 @@ class TfPoses:
     (stamp 0) are cached. The listener starts on the first question (or `listen()`), so a node that never
     needs tf spends no thread on deserialising /tf."""
 
-    def __init__(self, fixed_frame: str) -> None:
-        self._fixed = fixed_frame
+    def __init__(self, fixed_frame: str, prefix: TfPrefix | None = None) -> None:
+        self._tf = prefix or TfPrefix()
+        self._fixed = self._tf.add(fixed_frame)
         self._static: dict[str, list[list[float]]] = {}
         self._buffer: tf2_ros.Buffer | None = None
         self._listener: tf2_ros.TransformListener | None = None
@@ -85,7 +88,7 @@ class TfPoses:
         self.listen()
         assert self._buffer is not None
         try:  # the core call: Buffer.lookup_transform adds a can_transform round trip (~4 us) that only waits
-            msg = self._buffer.lookup_transform_core(self._fixed, frame, self._time0)
+            msg = self._buffer.lookup_transform_core(self._fixed, self._tf.add(frame), self._time0)
         except _TF_ERRORS as err:
             raise LookupError(str(err)) from err
         t, q = msg.transform.translation, msg.transform.rotation
@@ -120,8 +123,9 @@ class ContactControlRos:
         self._ended = threading.Condition(lock)
         self._emit = emit or self.send
         self._local = local_listeners
+        self.tf = for_this_node()  # frames out get the robot's tf prefix, frames in lose it
         self._twist = TwistStamped()
-        self._twist.header.frame_id = s.velocity_command_frame
+        self._twist.header.frame_id = self.tf.add(s.velocity_command_frame)
         # Synchronous: the twist leaves in the wrench callback, ~90 us sooner than through rospy's sender
         # thread. A subscriber that stops reading then blocks this node, and jog_arm halts on its timeout.
         queue = None if s.publish_synchronously else 1
@@ -131,7 +135,7 @@ class ContactControlRos:
         # The compensated, unfiltered contact force (control frame; torque 0) for jog_arm's contact guard in
         # the two-node layout, sent only while somebody listens.
         self._contact_msg = WrenchStamped()
-        self._contact_msg.header.frame_id = s.control_frame
+        self._contact_msg.header.frame_id = self.tf.add(s.control_frame)
         self._contact_pub = rospy.Publisher(private_ns + "contact_wrench", WrenchStamped, queue_size=1,
                                             tcp_nodelay=True)
         # Rare (a touch, a move's end): published from the cycle that found them, latched for late joiners.
@@ -141,7 +145,7 @@ class ContactControlRos:
         self._robot_stop_sub = rospy.Subscriber(s.robot_stop_topic, String, self._on_robot_stop, queue_size=5,
                                                 tcp_nodelay=True)
         self._status_msg = ContactControlStatus(axes=[AxisState(axis=name) for name in AXES])
-        self._status_msg.header.frame_id = s.control_frame
+        self._status_msg.header.frame_id = self.tf.add(s.control_frame)
         # Service names in the node's namespace (not private), as the original served them.
         self._services = [
             rospy.Service("configure_cartesian_impedance", ConfigureForceControl, self._on_configure),
@@ -184,7 +188,7 @@ class ContactControlRos:
                 force, frame, t = contact
                 msg = self._contact_msg
                 msg.header.stamp = rospy.Time.from_sec(t)
-                msg.header.frame_id = frame
+                msg.header.frame_id = self.tf.add(frame)
                 f = msg.wrench.force
                 f.x, f.y, f.z = force
                 self._contact_pub.publish(msg)
@@ -208,12 +212,12 @@ class ContactControlRos:
         msg = ContactEvent(type=event.kind, type_name=EVENT_NAMES[event.kind], move_id=event.move_id,
                            message=event.message)
         msg.header.stamp = rospy.Time.from_sec(event.t)
-        msg.header.frame_id = self._stage.frame
+        msg.header.frame_id = self.tf.add(self._stage.frame)
         f, q = msg.wrench.force, msg.wrench.torque
         f.x, f.y, f.z, q.x, q.y, q.z = event.wrench
         if event.pose is not None:
             msg.pose.header.stamp = msg.header.stamp
-            msg.pose.header.frame_id = self._s.fixed_frame
+            msg.pose.header.frame_id = self.tf.add(self._s.fixed_frame)
             p, o = msg.pose.pose.position, msg.pose.pose.orientation
             p.x, p.y, p.z = (row[3] for row in event.pose[:3])
             o.x, o.y, o.z, o.w = matrix_quaternion(event.pose)
@@ -256,7 +260,7 @@ class ContactControlRos:
     def _on_path_reference(self, msg: PathReference) -> None:
         """The path law's reference (fixed frame), timed by its arrival on this node's clock."""
         frame = msg.header.frame_id
-        if frame and frame.lstrip("/") != self._s.fixed_frame:
+        if frame and self.tf.bare(frame) != self._s.fixed_frame:
             rospy.logwarn_throttle(5.0, "contact_control: ~path_reference in %s ignored: it must be in %s",
                                    frame, self._s.fixed_frame)
             return
@@ -400,7 +404,7 @@ class ContactControlRos:
             # replay just after hand-guiding was switched off: "a contact move is running").
             active, reacting = self._stage.ctrl.move_active, any(self._stage.ctrl.reacting())
         msg = self._status_msg  # reused: the status timer allocates nothing per cycle
-        msg.header.frame_id = self._stage.frame
+        msg.header.frame_id = self.tf.add(self._stage.frame)
         msg.header.stamp = stamp
         msg.guiding = guiding
         msg.safety = r.safety

@@ -21,6 +21,7 @@ import rospy
 import tf2_ros
 from compliant_common.diagnostics import OK, Report
 from compliant_common.ros_diagnostics import DiagnosticsPublisher
+from compliant_common.ros_tf_prefix import for_this_node
 from compliant_common.typedefs import FloatArray
 from compliant_control_msgs.msg import (
     ContactControlStatus,
@@ -62,6 +63,7 @@ class TaskServer:
         self._configure = rospy.ServiceProxy(rospy.resolve_name("configure_laws"), ConfigureLaws)
         self._stop = rospy.ServiceProxy(cc + "/stop", Trigger)
         self.tf = tf2_ros.Buffer()
+        self.tf_prefix = for_this_node()  # the robot's frames on tf and in messages (README, Namespaces)
         self._listener: tf2_ros.TransformListener | None = None
         self._lock = threading.Lock()
         self._status: ContactControlStatus | None = None
@@ -137,7 +139,9 @@ class TaskServer:
 
     def _tool(self) -> FloatArray | None:
         try:
-            tf = self.tf.lookup_transform(self.fixed_frame, self.eef_frame, rospy.Time(0))
+            prefix = self.tf_prefix
+            tf = self.tf.lookup_transform(prefix.add(self.fixed_frame), prefix.add(self.eef_frame),
+                                          rospy.Time(0))
         except _TF_ERRORS:
             return None
         p, q = tf.transform.translation, tf.transform.rotation
@@ -166,7 +170,7 @@ class TaskServer:
         ref = command.reference
         if ref is not None:
             msg = PathReference()
-            msg.header.stamp, msg.header.frame_id = rospy.Time.now(), self.fixed_frame
+            msg.header.stamp, msg.header.frame_id = rospy.Time.now(), self.tf_prefix.add(self.fixed_frame)
             p, q, v = msg.pose.position, msg.pose.orientation, msg.velocity
             p.x, p.y, p.z = ref.position
             q.x, q.y, q.z, q.w = ref.quaternion
@@ -367,7 +371,7 @@ class TaskServer:
         result.peak_force, result.peak_torque = r.peak_force, r.peak_torque
         if r.end_pose is not None:
             pose = result.end_pose
-            pose.header.stamp, pose.header.frame_id = rospy.Time.now(), self.fixed_frame
+            pose.header.stamp, pose.header.frame_id = rospy.Time.now(), self.tf_prefix.add(self.fixed_frame)
             p, o = pose.pose.position, pose.pose.orientation
             p.x, p.y, p.z = (float(x) for x in r.end_pose[:3, 3])
             o.x, o.y, o.z, o.w = matrix_quaternion(r.end_pose[:3, :3].tolist())

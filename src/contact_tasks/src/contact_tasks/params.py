@@ -34,7 +34,7 @@ class TaskServerSettings:
     path_horizon_step: float = param(0.02, unit="s", gt=0.0, doc="the time between the horizon's poses")
     feedback_rate: float = param(10.0, unit="Hz", gt=0.0, le=100.0, doc="action feedback rate")
     jog_arm: str = param(
-        "/jog_arm_server", nonempty=True,
+        "jog_arm_server", nonempty=True,
         doc="jog_arm's namespace: a task's `body_region` is set there (dynamic_reconfigure) while it runs",
     )
     status_timeout: float = param(2.0, unit="s", gt=0.0, doc="a task is refused when contact_control's "

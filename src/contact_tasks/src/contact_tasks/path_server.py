@@ -14,6 +14,7 @@ import actionlib
 import numpy as np
 import rospy
 import tf2_ros
+from compliant_common.tf_prefix import TfPrefix
 from compliant_common.typedefs import FloatArray
 from compliant_control_msgs.msg import (
     FollowPathAtForceAction,
@@ -57,6 +58,7 @@ class TaskLoop(Protocol):
     fixed_frame: str
     cc: str
     tf: tf2_ros.Buffer
+    tf_prefix: TfPrefix
     busy: threading.Lock
 
     def carry_out(self, task: Task | Callable[[FloatArray], Task], preempted: Callable[[], bool],
@@ -90,10 +92,10 @@ class FollowPathServer:
     def _to_fixed(self, frame: str, rows: list[list[float]]) -> list[list[float]]:
         """The poses in contact_control's fixed frame (tf, the latest transform)."""
         node = self._node
-        if not frame or frame == node.fixed_frame:
+        if not frame or node.tf_prefix.bare(frame) == node.fixed_frame:
             return rows
         try:
-            tf = node.tf.lookup_transform(node.fixed_frame, frame, rospy.Time(0),
+            tf = node.tf.lookup_transform(node.tf_prefix.add(node.fixed_frame), frame, rospy.Time(0),
                                           rospy.Duration(node.s.status_timeout))
         except _TF_ERRORS as err:
             raise TaskError(f"path.header.frame_id: no transform {node.fixed_frame} -> {frame}: "

@@ -16,6 +16,7 @@ from collections.abc import Sequence
 
 import rospy
 from compliant_common.ros_master import MasterWatch
+from compliant_common.ros_tf_prefix import for_this_node
 from compliant_common.ros_ticker import start_ticker
 from compliant_common.runtime import tune_runtime
 from contact_control.bias_map import BiasMapError
@@ -89,15 +90,17 @@ class ControlStackNode:
             payload.feed(wrench)
         with self._lock:
             t = rospy.get_time()
-            self._publish(self.pipeline.on_wrench(wrench, msg.header.frame_id, stamp, t), t)
+            frame = self.contact_ros.tf.bare(msg.header.frame_id)
+            self._publish(self.pipeline.on_wrench(wrench, frame, stamp, t), t)
             self.contact_ros.send_contact()  # ~contact_wrench, only while somebody listens (named_poses)
 
     def _on_twist(self, msg: TwistStamped) -> None:
         lin, ang = msg.twist.linear, msg.twist.angular
         self.jog_ros.ensure_frame(msg.header.frame_id)
+        frame = self.jog_ros.tf.bare(msg.header.frame_id)
         with self._lock:
             t = rospy.get_time()
-            out = self.pipeline.on_twist((lin.x, lin.y, lin.z, ang.x, ang.y, ang.z), msg.header.frame_id,
+            out = self.pipeline.on_twist((lin.x, lin.y, lin.z, ang.x, ang.y, ang.z), frame,
                                          msg.header.stamp.to_sec(), t)
             self._publish(out, t)
 
@@ -132,7 +135,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     settings = read_settings(cc_ns)
     if jog is None or settings is None:
         return 1
-    tf = TfPoses(settings.fixed_frame)
+    tf = TfPoses(settings.fixed_frame, for_this_node())
     try:
         pipeline = CompliantPipeline(settings, jog[0], jog[1], tf)
     except (SettingsError, KinematicsError) as err:

@@ -66,7 +66,7 @@ class JogArmNode:
     def _on_contact_wrench(self, msg: WrenchStamped) -> None:
         f = msg.wrench.force
         with self._lock:
-            self.stage.on_contact_wrench((f.x, f.y, f.z), msg.header.frame_id.lstrip("/"), self._now())
+            self.stage.on_contact_wrench((f.x, f.y, f.z), self.ros.tf.bare(msg.header.frame_id), self._now())
 
     def _on_twist(self, msg: TwistStamped) -> None:
         """An outside twist (keyboard, GUI, rostopic pub): through the contact guard."""
@@ -80,7 +80,8 @@ class JogArmNode:
         lin, ang = msg.twist.linear, msg.twist.angular
         self.ros.ensure_frame(msg.header.frame_id)
         with self._lock:
-            cycle = self.stage.on_twist((lin.x, lin.y, lin.z, ang.x, ang.y, ang.z), msg.header.frame_id,
+            cycle = self.stage.on_twist((lin.x, lin.y, lin.z, ang.x, ang.y, ang.z),
+                                        self.ros.tf.bare(msg.header.frame_id),
                                         self._now(), guarded=guarded)
             self.ros.publish(cycle)
             self.ros.log_notes()

@@ -15,6 +15,7 @@ import tf2_ros
 from compliant_common.diagnostics import Report
 from compliant_common.ros_diagnostics import DiagnosticsPublisher
 from compliant_common.ros_live_params import LiveParams
+from compliant_common.ros_tf_prefix import for_this_node
 from compliant_common.typedefs import ParamMap
 from compliant_control_msgs.msg import JogStatus
 from geometry_msgs.msg import Vector3
@@ -47,6 +48,7 @@ class JogArmRos:
     def __init__(self, stage: JogStage, lock: threading.Lock, private_ns: str = "~") -> None:
         s = self._s = stage.settings
         self._stage, self._lock = stage, lock
+        self.tf = for_this_node()  # commands' frames carry the robot's tf prefix, the model's lack it
         self._tf_buffer: tf2_ros.Buffer | None = None
         self._tf_listener: tf2_ros.TransformListener | None = None
         self._frames_ready: set[str] = set()
@@ -142,10 +144,10 @@ class JogArmRos:
         stage.notes.clear()
 
     # --- frames ---
-    def ensure_frame(self, frame: str) -> None:
-        """Makes a frame tf knows but the model does not usable (looked up once, then cached). Without the
-        lock: the tf lookup may wait."""
-        frame = frame.lstrip("/") or self._s.default_cmd_frame
+    def ensure_frame(self, received: str) -> None:
+        """Makes a frame tf knows but the model does not usable (looked up once, then cached) under its bare
+        name (`tf.bare`). Without the lock: the tf lookup may wait."""
+        frame = self.tf.bare(received) or self._s.default_cmd_frame
         if frame in self._frames_ready:
             return
         with self._lock:
@@ -157,7 +159,8 @@ class JogArmRos:
             self._tf_buffer = tf2_ros.Buffer()
             self._tf_listener = tf2_ros.TransformListener(self._tf_buffer)
         try:
-            tf = self._tf_buffer.lookup_transform(self._s.planning_frame, frame, rospy.Time(0))
+            tf = self._tf_buffer.lookup_transform(self.tf.add(self._s.planning_frame),
+                                                  received.lstrip("/") or self.tf.add(frame), rospy.Time(0))
         except _TF_ERRORS as err:  # not cached: tf may still be filling up; try again next command
             rospy.logwarn_throttle(
                 WARN_PERIOD, f"jog_arm_server: frame {frame!r} is in neither the robot model nor tf: {err}"

@@ -24,6 +24,7 @@ import rospy
 from compliant_common.diagnostics import Report
 from compliant_common.ros_diagnostics import DiagnosticsPublisher
 from compliant_common.ros_master import MasterWatch
+from compliant_common.ros_tf_prefix import for_this_node
 from compliant_common.ros_time import timer
 from compliant_common.rospy_internals import drop_clock_subscription, header_stamp_ns, set_rostime
 from compliant_common.runtime import tune_runtime
@@ -90,6 +91,7 @@ class MujocoDriverNode:
                 rospy.loginfo("mujoco_driver: collision geometry of %s", entry)
         self._lock = threading.Lock()
         self._base_frame = s.base_frame or urdf_root_link(urdf)
+        self._tf = for_this_node()  # the robot's tf prefix on the frames it publishes (README, Namespaces)
         self._clock_offset = 0.0  # simulated time before the last ~reset, so /clock never runs backwards
         # Made before anything is advertised: it refuses a profile naming links the description lacks.
         self._driver = EmulatedDriver(sim, profile, self._lock) if profile is not None else None
@@ -116,9 +118,9 @@ class MujocoDriverNode:
         # Preallocated messages.
         self._joint_msg = JointState(name=list(sim.joint_names))
         self._wrench_msg = WrenchStamped()
-        self._wrench_msg.header.frame_id = s.ft_frame or scene_cfg.links.ft_sensor
+        self._wrench_msg.header.frame_id = self._tf.add(s.ft_frame or scene_cfg.links.ft_sensor)
         self._pose_msg = PoseStamped()
-        self._pose_msg.header.frame_id = self._base_frame
+        self._pose_msg.header.frame_id = self._tf.add(self._base_frame)
         self._clock_msg = Clock()
         self._rtf_msg = Float64()
         self._rtf: float | None = None
@@ -512,7 +514,7 @@ class MujocoDriverNode:
         self._echoed.echo(stamp)
 
     def _check_push_frame(self, frame: str) -> None:
-        if frame and frame.lstrip("/") != self._base_frame:
+        if frame and self._tf.bare(frame) != self._base_frame:
             raise CommandError(f"push wrench frame must be {self._base_frame!r} (or empty), got {frame!r}")
 
     def _show_push(self, _event: object = None) -> None:
@@ -523,7 +525,7 @@ class MujocoDriverNode:
                 return
             self._push_shown = wrench
         msg = WrenchStamped()
-        msg.header.stamp, msg.header.frame_id = rospy.Time.now(), self._base_frame
+        msg.header.stamp, msg.header.frame_id = rospy.Time.now(), self._tf.add(self._base_frame)
         f, t = msg.wrench.force, msg.wrench.torque
         f.x, f.y, f.z, t.x, t.y, t.z = wrench
         self._push_pub.publish(msg)

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 import roslib.message
 import rospy
+from compliant_common.ros_tf_prefix import for_this_node
 from geometry_msgs.msg import TransformStamped
 from std_msgs.msg import Bool, Float64, Float64MultiArray
 from std_srvs.srv import Trigger, TriggerResponse
@@ -85,8 +86,9 @@ class EmulatedDriver:
         #: Under the lock: why a command to a controller does not move the arm now ("" = it does).
         self.refusal: Callable[[str], str] = emu.refusal
         self._tf_msg = TFMessage(transforms=[TransformStamped() for _ in profile.tf])
+        prefix = for_this_node()
         for t, spec in zip(self._tf_msg.transforms, profile.tf, strict=True):
-            t.header.frame_id, t.child_frame_id = spec.parent, spec.child
+            t.header.frame_id, t.child_frame_id = prefix.add(spec.parent), prefix.add(spec.child)
         self._scaling_msg = Float64(1.0)
         self._tf_pub: rospy.Publisher | None = None
         self._scaling_pub: rospy.Publisher | None = None

@@ -68,12 +68,12 @@ class NamedPoseSettings:
         "paused already; empty: never pause",
     )
     contact_control_status: str = param(
-        "/contact_control_node/status", nonempty=True,
+        "contact_control_node/status", nonempty=True,
         doc="compliant_control_msgs/ContactControlStatus input: no move while a contact move runs",
     )
     # ~follow_joint_trajectory (README, FollowJointTrajectory)
     contact_wrench: str = param(
-        "/contact_control_node/contact_wrench", nonempty=True,
+        "contact_control_node/contact_wrench", nonempty=True,
         doc="geometry_msgs/WrenchStamped input while a trajectory runs: contact_control's contact force",
     )
     trajectory_force_limit: float = param(

@@ -17,6 +17,7 @@ import rospy
 import tf2_ros
 from compliant_common.diagnostics import OK, Report
 from compliant_common.ros_diagnostics import DiagnosticsPublisher
+from compliant_common.ros_tf_prefix import for_this_node
 from compliant_common.ros_time import MonotonicTimer, TimerEvent, timer
 from compliant_control_msgs.srv import (
     ListPrograms,
@@ -68,7 +69,8 @@ class TeachNode:
         self._tf = tf2_ros.Buffer()
         self._listener: tf2_ros.TransformListener | None = None
         self._pose = PoseStamped()
-        self._pose.header.frame_id = base_frame
+        self._prefix = for_this_node()  # the robot's frames on tf and in messages; programs keep bare names
+        self._pose.header.frame_id = self._prefix.add(base_frame)
         # Inputs only while recording: idle, the node costs the stack nothing (no 500 Hz deserialising).
         self._subs: list[rospy.Subscriber] = []
         self._timer: MonotonicTimer | rospy.Timer | None = None
@@ -143,7 +145,8 @@ class TeachNode:
         if joints is None:
             return
         try:
-            tf = self._tf.lookup_transform(rec.base_frame, rec.tip_frame, rospy.Time(0))
+            tf = self._tf.lookup_transform(self._prefix.add(rec.base_frame), self._prefix.add(rec.tip_frame),
+                                           rospy.Time(0))
         except _TF_ERRORS as err:
             if 0.0 < self._warn_after < rospy.get_time():
                 self._warn_after = 0.0

@@ -18,6 +18,7 @@ import numpy as np
 import rospy
 import tf2_ros
 from compliant_common.errors import StackError
+from compliant_common.ros_tf_prefix import for_this_node
 from compliant_control_msgs.msg import (
     AxisLaw,
     ContactControlStatus,
@@ -79,7 +80,8 @@ class ReplayServer:
         self._lock = threading.Lock()
         self._playback: Playback | None = None
         self._ref = PathReference(horizon_step=s.replay_horizon_step)
-        self._ref.header.frame_id = base_frame
+        self._prefix = for_this_node()  # the robot's frames on tf and in messages; programs keep bare names
+        self._ref.header.frame_id = self._prefix.add(base_frame)
         self._ref.horizon = [Pose() for _ in range(round(s.replay_horizon / s.replay_horizon_step))]
         self._server = actionlib.SimpleActionServer("~replay", ReplayProgramAction, self._execute,
                                                     auto_start=False)
@@ -213,7 +215,9 @@ class ReplayServer:
 
     def _tool(self) -> np.ndarray | None:
         try:
-            tf = self._tf.lookup_transform(self.base_frame, self.tip_frame, rospy.Time(0))
+            prefix = self._prefix
+            tf = self._tf.lookup_transform(prefix.add(self.base_frame), prefix.add(self.tip_frame),
+                                           rospy.Time(0))
         except _TF_ERRORS:
             return None
         p = tf.transform.translation

@@ -6,7 +6,7 @@ from __future__ import annotations
 from robot_setup.driver import GENERIC_TRAJECTORY_TOPIC
 from robot_setup.plan import Plan, command_line
 from robot_setup.templates.driver_text import MESSAGE, model_words, switch_words
-from robot_setup.templates.text import comment
+from robot_setup.templates.text import comment, in_namespace
 
 __all__ = ["hardware_launch"]
 
@@ -81,7 +81,7 @@ def _launch_file(
     the `named_poses` args (a generic driver and a profile's driver differ only in these), RViz on the
     driver's `wrench_topic` with viewer:=rviz."""
     args = "".join(f'\n    <arg name="{key}" value="{value}"/>' for key, value in named_poses.items())
-    return f"""<?xml version="1.0"?>
+    return in_namespace(f"""<?xml version="1.0"?>
 <!--
 {header}-->
 <launch>
@@ -119,4 +119,4 @@ def _launch_file(
     <arg name="output" value="$(arg output)"/>
   </include>
 </launch>
-"""
+""")

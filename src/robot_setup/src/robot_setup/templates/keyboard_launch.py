@@ -20,16 +20,25 @@ def keyboard_launch(plan: Plan) -> str:
   <arg name="hardware" default="false" doc="true: real robot (hardware.launch) instead of the simulation"/>
   <arg name="viewer" default="true" doc="open MuJoCo's viewer (simulation only; only if a DISPLAY exists)"/>
   <arg name="launch_prefix" default="" doc="e.g. 'xterm -e' to give key_to_twist a terminal of its own"/>
+  <arg name="ns" default="" doc="the robot's namespace (sim.launch's ns)"/>
+  <arg name="tf_prefix" default="" doc="the robot's tf prefix (sim.launch's tf_prefix)"/>
 
   <include unless="$(arg hardware)" file="$(find {pkg})/launch/sim.launch">
     <arg name="viewer" value="$(arg viewer)"/>
+    <arg name="ns" value="$(arg ns)"/>
+    <arg name="tf_prefix" value="$(arg tf_prefix)"/>
   </include>
-  <include if="$(arg hardware)" file="$(find {pkg})/launch/hardware.launch"/>
+  <include if="$(arg hardware)" file="$(find {pkg})/launch/hardware.launch">
+    <arg name="ns" value="$(arg ns)"/>
+    <arg name="tf_prefix" value="$(arg tf_prefix)"/>
+  </include>
 
-  <include file="$(find keyboard_publisher)/launch/keyboard.launch">
-    <arg name="topic" value="/jog_arm_server/delta_jog_cmds"/>
-    <arg name="frame_id" value="{plan.base}"/>
-    <arg name="launch_prefix" value="$(arg launch_prefix)"/>
-  </include>
+  <group ns="$(eval ns or '/')">
+    <include file="$(find keyboard_publisher)/launch/keyboard.launch">
+      <arg name="topic" value="jog_arm_server/delta_jog_cmds"/>
+      <arg name="frame_id" value="{plan.base}"/>
+      <arg name="launch_prefix" value="$(arg launch_prefix)"/>
+    </include>
+  </group>
 </launch>
 """

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from robot_setup.driver import GENERIC_TRAJECTORY_TOPIC
 from robot_setup.plan import Plan
-from robot_setup.templates.text import generated_by
+from robot_setup.templates.text import generated_by, in_namespace
 
 __all__ = ["sim_launch"]
 
@@ -14,7 +14,7 @@ def sim_launch(plan: Plan) -> str:
     name = plan.spec.name
     pkg = f"{name}_custom"
     generated = generated_by(plan.spec, with_driver=False)
-    return f"""<?xml version="1.0"?>
+    return in_namespace(f"""<?xml version="1.0"?>
 <!--
   Simulated {name} compliant-control stack ({generated.replace('`', '')}): robot_description,
   robot_state_publisher, the MuJoCo driver (headless; viewer:=true for its window, viewer:=rviz for RViz), jog_arm_server and
@@ -70,4 +70,4 @@ def sim_launch(plan: Plan) -> str:
     <arg name="output" value="$(arg output)"/>
   </include>
 </launch>
-"""
+""")

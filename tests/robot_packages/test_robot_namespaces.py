@@ -1,0 +1,106 @@
+"""Two robots on one master (README, *Namespaces*): the simulated UR5 as `left` and the Panda as `right`, each
+sim.launch with `ns` and `tf_prefix`. No topic, service, parameter, node or tf frame is shared, and each arm
+jogs on its own commands only."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import time
+import xmlrpc.client
+
+import numpy as np
+import pytest
+
+pytest.importorskip("compliant_control_msgs.msg", reason="needs devel/setup.bash (make test sources it)")
+
+from compliant_control_msgs.msg import ContactControlStatus
+from geometry_msgs.msg import PoseStamped, TwistStamped
+from harness.launch import run_launch
+from harness.waiting import Collector, wait_until
+from tf2_msgs.msg import TFMessage
+
+pytestmark = pytest.mark.cell
+
+ROBOTS = {"left": ("ur5_custom", "base_link"), "right": ("panda_custom", "panda_link0")}
+# What every ROS graph shares by convention: the log, tf (the prefixes keep the frames apart) and diagnostics.
+SHARED = {"/rosout", "/rosout_agg", "/tf", "/tf_static", "/diagnostics", "/use_sim_time"}
+
+
+def _master() -> xmlrpc.client.ServerProxy:
+    return xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"])
+
+
+def _ours(node: str) -> bool:
+    return any(node.startswith(f"/{ns}/") for ns in ROBOTS)
+
+
+def _nodes() -> set[str]:
+    publishers, subscribers, services = _master().getSystemState("/test")[2]
+    return {n for _, nodes in [*publishers, *subscribers, *services] for n in nodes}
+
+
+def _names_of_our_nodes() -> set[str]:
+    """Every topic and service a node of the two stacks publishes, subscribes or serves."""
+    publishers, subscribers, services = _master().getSystemState("/test")[2]
+    return {name for name, nodes in [*publishers, *subscribers, *services] if any(_ours(n) for n in nodes)}
+
+
+def test_two_robots_share_no_name_and_jog_apart(ros_node):
+    rospy = ros_node
+    params_before, nodes_before = set(_master().getParamNames("/test")[2]), _nodes()
+    with contextlib.ExitStack() as stack:
+        launched = {ns: stack.enter_context(run_launch(robot, "sim.launch", args={"ns": ns, "tf_prefix": ns}))
+                    for ns, (robot, _) in ROBOTS.items()}
+        for ns, h in launched.items():
+            h.wait_for_service(f"/{ns}/configure_laws", timeout=90)
+            h.wait_for_service(f"/{ns}/named_poses/move_to", timeout=60)
+        tf = Collector("/tf", TFMessage)
+        poses = {ns: Collector(f"/{ns}/mujoco_driver/eef_pose", PoseStamped) for ns in ROBOTS}
+        for c in (tf, *poses.values()):
+            c.wait_for(5, timeout=20)
+
+        names = _names_of_our_nodes()
+        loose = sorted(n for n in names if n not in SHARED and not _ours(n))
+        assert not loose, f"names of the two stacks outside their namespaces: {loose}"
+        params = set(_master().getParamNames("/test")[2]) - params_before
+        loose = sorted(p for p in params
+                       if p not in SHARED and not _ours(p) and not p.startswith("/roslaunch"))
+        assert not loose, f"parameters outside the namespaces: {loose}"
+        loose = sorted(n for n in _nodes() - nodes_before if not _ours(n))
+        assert not loose, f"nodes outside the namespaces: {loose}"
+        frames = {name for msg in tf.wait_for(50, timeout=20) for t in msg.transforms
+                  for name in (t.header.frame_id, t.child_frame_id)}
+        tf.close()
+        assert frames and all(f.split("/")[0] in ROBOTS for f in frames), sorted(frames)
+        assert {f.split("/")[0] for f in frames} == set(ROBOTS)
+        for ns, (_, base) in ROBOTS.items():  # the driver's and contact_control's frames too
+            assert poses[ns].last().header.frame_id.startswith(f"{ns}/")
+            status = Collector(f"/{ns}/contact_control_node/status", ContactControlStatus)
+            assert status.wait_for(1, timeout=10)[0].header.frame_id == f"{ns}/{base}"
+            status.close()
+
+        # Jog each arm in turn, the left with its frame's tf name, the right with the bare name: only the
+        # jogged arm moves.
+        for ns, frame in (("left", "left/base_link"), ("right", "panda_link0")):
+            start = {n: _position(c) for n, c in poses.items()}
+            pub = rospy.Publisher(f"/{ns}/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1)
+            wait_until(lambda pub=pub: pub.get_num_connections() > 0, 10, f"{ns}'s jog_arm to subscribe")
+            twist = TwistStamped()
+            twist.header.frame_id = frame
+            twist.twist.linear.z = 0.02
+            began = rospy.get_time()
+            while rospy.get_time() - began < 1.0:
+                twist.header.stamp = rospy.Time.now()
+                pub.publish(twist)
+                time.sleep(0.01)  # the sender's rate, as key_to_twist's repeat
+            pub.unregister()
+            moved = {n: float(np.linalg.norm(_position(c) - start[n])) for n, c in poses.items()}
+            other = next(n for n in ROBOTS if n != ns)
+            assert moved[ns] > 0.01, f"{ns} moved {moved[ns] * 1e3:.1f} mm on its 20 mm jog"
+            assert moved[other] < 0.001, f"{other} moved {moved[other] * 1e3:.1f} mm on {ns}'s jog"
+
+
+def _position(c: Collector) -> np.ndarray:
+    p = c.last().pose.position
+    return np.array([p.x, p.y, p.z])
