@@ -85,7 +85,7 @@ def test_ur_profile_hardware_files_use_its_topics_frames_and_controllers(ur3_pla
         "joint_states_topic": profile.joint_states_topic,
         "output": "$(arg output)",
     }
-    assert launch.find("remap") is None  # joint_states is robot_state_publisher's own topic
+    assert launch.find(".//remap") is None  # joint_states is robot_state_publisher's own topic
     # The user's switch, in the header and the README: start jog_arm's controller, stop the running one.
     header = files["launch/hardware.launch"]
     assert f"switch {velocity.name} on" in header and f"stopping {running_trajectory.name}" in header
@@ -168,7 +168,7 @@ def test_a_profile_path_of_another_driver_sets_its_names_sign_and_payload(ur3_pl
     directions = [cc.get(f"ft_{axis}_direction", 1) for axis in "xyz"]
     assert directions == [sign] * 3
     assert cc["lp_filter_delta_t"] == pytest.approx(0.02)
-    remap = launch.find("remap")
+    remap = launch.find(".//remap")  # in the robot's <group ns>
     assert remap is not None and remap.attrib == {"from": "joint_states", "to": "acme/joint_states"}
     assert _named_poses_args(launch)["trajectory_topic"] == "acme_traj/command"
     assert _named_poses_args(launch)["joint_states_topic"] == "acme/joint_states"

@@ -116,3 +116,18 @@ def test_the_curved_surface_runs_in_its_own_scene_and_keeps_the_tool_normal(tmp_
     assert figures["force RMS error"] <= 1.5 and figures["max |F|"] <= 20.0
     assert figures["true normal RMS"] <= 3.0
     assert (tmp_path / "curved_surface.png").exists()
+
+
+@pytest.mark.e2e  # scripts/demo runs the simulation
+@pytest.mark.cell
+def test_a_demonstration_runs_with_the_robot_in_a_namespace(tmp_path):
+    """`--ns left`: the emulated UR driver, hardware.launch and the demonstrations all under /left (frames
+    left/...); the controller switch and the wrench topic are found there."""
+    command = _demo("--robot", "ur5", "--driver", "ur_robot_driver", "--ns", "left", "--only", "follower_z",
+                    "--bias-map", "none", "--output", str(tmp_path))
+    run = _run(command, capture_output=True, text=True, timeout=300, check=False)
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    assert "[PASS] follower_z" in run.stdout
+    log = (tmp_path / "launch.log").read_text()
+    assert "/left/mujoco_driver/profile: ur_robot_driver" in log  # the driver's parameters
+    assert "/left/contact_control_node/ft_in_topic: wrench" in log  # hardware.launch's

@@ -81,8 +81,11 @@ class _Inputs:
 
 def _sensor_rotation(buffer, fixed: str, frame: str) -> np.ndarray:  # type: ignore[no-untyped-def]
     import rospy
+    from compliant_common.ros_tf_prefix import for_this_node
 
-    q = buffer.lookup_transform(fixed, frame, rospy.Time(0), rospy.Duration(1.0)).transform.rotation
+    prefix = for_this_node()  # the robot's frames on tf (README, Namespaces)
+    q = buffer.lookup_transform(prefix.add(fixed), prefix.add(frame), rospy.Time(0),
+                                rospy.Duration(1.0)).transform.rotation
     return np.array(quaternion_matrix(q.x, q.y, q.z, q.w))
 
 

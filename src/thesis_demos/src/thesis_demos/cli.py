@@ -42,12 +42,12 @@ def _args(argv: Sequence[str]) -> argparse.Namespace:
     parser.add_argument("--demos-config", default="", help="a demos.yaml instead of the robot package's")
     parser.add_argument("--only", nargs="*", help="run only these demos (follower_z compliant_move_z ...)")
     parser.add_argument("--sensor-frame", default="ft_sensor")
-    parser.add_argument("--wrench-topic", default="/wrench", help="the wrist wrench (a real driver's topic)")
+    parser.add_argument("--wrench-topic", default="wrench", help="the wrist wrench (a real driver's topic)")
     parser.add_argument("--driver", default="", help="the driver profile behind the stack (demos.yaml's "
                         "contact_force.drivers may set its force limit)")
     parser.add_argument("--base-frame", default="", help="default: contact_control's ~fixed_frame")
     parser.add_argument("--timeout", type=float, default=60.0, help="seconds to wait for the stack")
-    parser.add_argument("--tasks", default="/task_server", help="contact_tasks' task_server (peg in hole)")
+    parser.add_argument("--tasks", default="task_server", help="contact_tasks' task_server (peg in hole)")
     parser.add_argument("--append", action="store_true", help="add to the output folder's report (a "
                         "demonstration in a scene of its own, run in a second launch)")
     return parser.parse_args(argv)

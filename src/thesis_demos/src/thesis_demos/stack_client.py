@@ -17,6 +17,7 @@ import numpy as np
 import rospy
 import tf2_ros
 from cartesian_impedance_msgs.srv import ConfigureForceControl
+from compliant_common.ros_tf_prefix import for_this_node
 from compliant_control_msgs.msg import ContactControlStatus, ContactEvent
 from compliant_control_msgs.srv import (
     ConfigureLaws,
@@ -39,15 +40,15 @@ __all__ = ["Names", "Series", "StackClient"]
 
 @dataclass(frozen=True)
 class Names:
-    """Where the stack's interfaces live."""
+    """Where the stack's interfaces live, relative to this node's namespace (README, Namespaces)."""
 
-    configure: str = "/configure_cartesian_impedance"
-    configure_laws: str = "/configure_laws"
-    contact_control: str = "/contact_control_node"
-    driver: str = "/mujoco_driver"
-    named_poses: str = "/named_poses"  # its ~move_to brings the arm to "start" (else the driver's ~reset)
-    teach: str = "/teach"  # teach's program_server (teach and replay)
-    wrench: str = "/wrench"
+    configure: str = "configure_cartesian_impedance"
+    configure_laws: str = "configure_laws"
+    contact_control: str = "contact_control_node"
+    driver: str = "mujoco_driver"
+    named_poses: str = "named_poses"  # its ~move_to brings the arm to "start" (else the driver's ~reset)
+    teach: str = "teach"  # teach's program_server (teach and replay)
+    wrench: str = "wrench"
     base_frame: str = ""  # empty: contact_control's ~fixed_frame
 
 
@@ -115,6 +116,7 @@ class StackClient:
         )
         self._tf = tf2_ros.Buffer()
         self._tf_listener = tf2_ros.TransformListener(self._tf)
+        self._tf_prefix = for_this_node()  # the robot's frames on tf
         self.pose = Series(3)
         self._status = Series(6)
         self._wrench = Series(3)
@@ -173,8 +175,9 @@ class StackClient:
             time.sleep(0.01)
 
     def _update_sensor_rotation(self, sensor_frame: str) -> None:
+        prefix = self._tf_prefix
         tf = self._tf.lookup_transform(
-            self._base_frame, sensor_frame, rospy.Time(0), rospy.Duration(5.0)
+            prefix.add(self._base_frame), prefix.add(sensor_frame), rospy.Time(0), rospy.Duration(5.0)
         )
         q = tf.transform.rotation
         x, y, z, w = q.x, q.y, q.z, q.w

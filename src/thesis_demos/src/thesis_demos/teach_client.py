@@ -49,7 +49,7 @@ REPLAY_TIMEOUT = 90.0  # [s] per replay (the pressed one: a 5 mm/s approach over
 class TeachFlow:
     """Runs teach and replay with a StackClient's connections and series."""
 
-    def __init__(self, stack: StackClient, teach: str = "/teach", timeout: float = 30.0) -> None:
+    def __init__(self, stack: StackClient, teach: str = "teach", timeout: float = 30.0) -> None:
         self.r = stack
         self._t0 = 0.0
         cc = stack.names.contact_control
