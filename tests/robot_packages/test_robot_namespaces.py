@@ -1,11 +1,13 @@
 """Two robots on one master (README, *Namespaces*): the simulated UR5 as `left` and the Panda as `right`, each
-sim.launch with `ns` and `tf_prefix`. No topic, service, parameter, node or tf frame is shared, and each arm
-jogs on its own commands only."""
+sim.launch with `ns` and `tf_prefix`. No topic, service, parameter, node or tf frame is shared, each arm jogs
+on its own commands only, and one arm's dead stack leaves the other's demonstrations passing."""
 
 from __future__ import annotations
 
 import contextlib
 import os
+import signal
+import subprocess
 import time
 import xmlrpc.client
 
@@ -17,6 +19,7 @@ pytest.importorskip("compliant_control_msgs.msg", reason="needs devel/setup.bash
 from compliant_control_msgs.msg import ContactControlStatus
 from geometry_msgs.msg import PoseStamped, TwistStamped
 from harness.launch import run_launch
+from harness.process import node_pid
 from harness.waiting import Collector, wait_until
 from tf2_msgs.msg import TFMessage
 
@@ -104,3 +107,54 @@ def test_two_robots_share_no_name_and_jog_apart(ros_node):
 def _position(c: Collector) -> np.ndarray:
     p = c.last().pose.position
     return np.array([p.x, p.y, p.z])
+
+
+def test_killing_one_robots_stack_halts_it_and_the_other_passes_its_demonstrations(ros_node, tmp_path):
+    """Faults stay local: the left arm's control_stack killed (SIGKILL) while it jogs at 20 mm/s, the left
+    arm stops as it does alone (its driver's command_timeout), and the right arm's follower and spring
+    demonstrations pass meanwhile, run in its namespace."""
+    rospy = ros_node
+    with contextlib.ExitStack() as stack:
+        launched = {ns: stack.enter_context(run_launch(robot, "sim.launch", args={"ns": ns, "tf_prefix": ns}))
+                    for ns, (robot, _) in ROBOTS.items()}
+        for ns, h in launched.items():
+            h.wait_for_service(f"/{ns}/configure_laws", timeout=90)
+        left = Collector("/left/mujoco_driver/eef_pose", PoseStamped)
+        left.wait_for(5, timeout=20)
+        pub = rospy.Publisher("/left/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1)
+        wait_until(lambda: pub.get_num_connections() > 0, 10, "left's jog_arm to subscribe")
+        twist = TwistStamped()
+        twist.header.frame_id = "left/base_link"
+        twist.twist.linear.z = 0.02
+
+        def jog_for(seconds: float) -> None:
+            began = rospy.get_time()
+            while rospy.get_time() - began < seconds:
+                twist.header.stamp = rospy.Time.now()
+                pub.publish(twist)
+                time.sleep(0.01)  # the sender's rate, as key_to_twist's repeat
+
+        jog_for(0.5)
+        killed_at = _position(left)
+        os.kill(node_pid("/left/control_stack"), signal.SIGKILL)
+        jog_for(1.0)  # the keyboard keeps sending: nothing is left to carry it out
+
+        def still() -> bool:  # the last 0.2 s of simulated poses (100 Hz) within 0.1 mm
+            recent = [m.pose.position for m in left.wait_for(1)[-20:]]
+            return len(recent) == 20 and np.ptp([[p.x, p.y, p.z] for p in recent], axis=0).max() < 1e-4
+
+        # The driver first waits for the dead stack (lockstep_wait, wall time), then its command_timeout
+        # (0.25 s simulated) stops the arm, as when the stack dies alone.
+        left.clear()
+        wait_until(still, 15, "the left arm to stop")
+        coast = float(np.linalg.norm(_position(left) - killed_at))
+        print(f"left arm: {coast * 1e3:.1f} mm from the kill to standstill")
+        assert coast < 0.01, f"the left arm ran {coast * 1e3:.1f} mm after its stack died"
+
+        env = dict(os.environ, ROS_NAMESPACE="/right", ROS_HOME=str(tmp_path))
+        demos = ["rosrun", "thesis_demos", "run_demos", "--robot", "panda", "--only", "follower_z",
+                 "spring_x", "--output", str(tmp_path)]
+        run = subprocess.run(demos, env=env, capture_output=True, text=True, timeout=300, check=False)
+        assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+        assert "[PASS] follower_z" in run.stdout and "[PASS] spring_x" in run.stdout
+        assert launched["right"].proc.poll() is None and launched["left"].proc.poll() is None
