@@ -78,7 +78,7 @@ Visualization Manager:
     - Class: rviz/MarkerArray
       Name: Stack (laws, velocity, obstacle, push, paths)
       Enabled: true
-      Marker Topic: /stack_markers/markers
+      Marker Topic: stack_markers/markers
       Queue Size: 10
       Namespaces: {{}}
       Value: true
