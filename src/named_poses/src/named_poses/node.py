@@ -264,6 +264,9 @@ class NamedPoseServer:
             if switch is not None:
                 back = self._switch(switch.undo())
             resumed = self._resume_jog(paused)
+        if isinstance(answer, str):  # the robot stopped: named after the clean-up, by when jog_arm names
+            # its cause (a UR's safety mode may arrive after its consequence, the program's stop)
+            answer = self._refuse(f"stopped on the way to {name}: {self._robot_stop or answer}")
         if switch is not None:
             note = f"; switched {list(switch.start)} on for the move (stopping {list(switch.stop)})"
             answer.message += note + (", then back" if back else f"; switching back failed: {back.reason}")
@@ -321,15 +324,16 @@ class NamedPoseServer:
 
     def _move(
         self, name: str, goal: np.ndarray, duration: float, msg: JointTrajectory
-    ) -> MoveToNamedPoseResponse:
-        """Sends the trajectory and waits for the arm to arrive."""
+    ) -> MoveToNamedPoseResponse | str:
+        """Sends the trajectory and waits for the arm to arrive; the robot's stop as jog_arm first named it
+        if it stopped on the way."""
         if duration > 0.0:
             self._pub.publish(msg)  # stamp 0: the driver starts it now
         rospy.loginfo("named_pose_server: to %s in %.2f s", name, duration)
         deadline = time.monotonic() + duration + self.settle_time
         while time.monotonic() < deadline and not rospy.is_shutdown():
             if self._robot_stop:  # the driver holds the arm: the move is over
-                return self._refuse(f"stopped on the way to {name}: {self._robot_stop}")
+                return self._robot_stop
             now = self._current()
             if now is not None and float(np.max(np.abs(now - goal))) <= self.tolerance:
                 return MoveToNamedPoseResponse(
