@@ -96,8 +96,7 @@ class ControlStackNode:
 
     def _on_twist(self, msg: TwistStamped) -> None:
         lin, ang = msg.twist.linear, msg.twist.angular
-        self.jog_ros.ensure_frame(msg.header.frame_id)
-        frame = self.jog_ros.tf.bare(msg.header.frame_id)
+        frame = self.jog_ros.ensure_frame(msg.header.frame_id)
         with self._lock:
             t = rospy.get_time()
             out = self.pipeline.on_twist((lin.x, lin.y, lin.z, ang.x, ang.y, ang.z), frame,

@@ -78,10 +78,9 @@ class JogArmNode:
 
     def _twist(self, msg: TwistStamped, guarded: bool) -> None:
         lin, ang = msg.twist.linear, msg.twist.angular
-        self.ros.ensure_frame(msg.header.frame_id)
+        frame = self.ros.ensure_frame(msg.header.frame_id)
         with self._lock:
-            cycle = self.stage.on_twist((lin.x, lin.y, lin.z, ang.x, ang.y, ang.z),
-                                        self.ros.tf.bare(msg.header.frame_id),
+            cycle = self.stage.on_twist((lin.x, lin.y, lin.z, ang.x, ang.y, ang.z), frame,
                                         self._now(), guarded=guarded)
             self.ros.publish(cycle)
             self.ros.log_notes()

@@ -144,17 +144,19 @@ class JogArmRos:
         stage.notes.clear()
 
     # --- frames ---
-    def ensure_frame(self, received: str) -> None:
+    def ensure_frame(self, received: str) -> str:
         """Makes a frame tf knows but the model does not usable (looked up once, then cached) under its bare
-        name (`tf.bare`). Without the lock: the tf lookup may wait."""
-        frame = self.tf.bare(received) or self._s.default_cmd_frame
+        name (`tf.bare`), which it returns ("": the default command frame). Without the lock: the tf lookup
+        may wait."""
+        bare = self.tf.bare(received)
+        frame = bare or self._s.default_cmd_frame
         if frame in self._frames_ready:
-            return
+            return bare
         with self._lock:
             known = self._stage.knows_frame(frame)
         if known:
             self._frames_ready.add(frame)
-            return
+            return bare
         if self._tf_buffer is None:
             self._tf_buffer = tf2_ros.Buffer()
             self._tf_listener = tf2_ros.TransformListener(self._tf_buffer)
@@ -165,7 +167,7 @@ class JogArmRos:
             rospy.logwarn_throttle(
                 WARN_PERIOD, f"jog_arm_server: frame {frame!r} is in neither the robot model nor tf: {err}"
             )
-            return
+            return bare
         q = tf.transform.rotation
         rotation = pin.Quaternion(q.w, q.x, q.y, q.z).normalized().toRotationMatrix()
         with self._lock:
@@ -173,6 +175,7 @@ class JogArmRos:
         self._frames_ready.add(frame)
         rospy.loginfo("jog_arm_server: commands in %r use its tf rotation to %r, looked up once (assumed "
                       "fixed)", frame, self._s.planning_frame)
+        return bare
 
     # --- services ---
     def _on_pause(self, _req: TriggerRequest) -> TriggerResponse:

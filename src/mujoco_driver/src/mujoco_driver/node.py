@@ -94,7 +94,7 @@ class MujocoDriverNode:
         self._tf = for_this_node()  # the robot's tf prefix on the frames it publishes (README, Namespaces)
         self._clock_offset = 0.0  # simulated time before the last ~reset, so /clock never runs backwards
         # Made before anything is advertised: it refuses a profile naming links the description lacks.
-        self._driver = EmulatedDriver(sim, profile, self._lock) if profile is not None else None
+        self._driver = EmulatedDriver(sim, profile, self._lock, self._tf) if profile is not None else None
         # Steps per publication; fractional for a profile's rate (30 Hz on 2 ms steps), exact on average.
         self._publish_every = (profile.publish_steps(sim.dt) if profile is not None
                                else s.publish_every(sim.dt))

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 import roslib.message
 import rospy
-from compliant_common.ros_tf_prefix import for_this_node
+from compliant_common.tf_prefix import TfPrefix
 from geometry_msgs.msg import TransformStamped
 from std_msgs.msg import Bool, Float64, Float64MultiArray
 from std_srvs.srv import Trigger, TriggerResponse
@@ -69,12 +69,14 @@ class EmulatedDriver:
         sim: The simulation (called only under ``lock``).
         profile: The resolved profile.
         lock: The node's simulation lock.
+        prefix: The robot's tf prefix, on the frames of the tf it publishes.
 
     Raises:
         ProfileError: If the profile names links the description lacks (before anything is advertised).
     """
 
-    def __init__(self, sim: Simulation, profile: DriverProfile, lock: threading.Lock) -> None:
+    def __init__(self, sim: Simulation, profile: DriverProfile, lock: threading.Lock,
+                 prefix: TfPrefix | None = None) -> None:
         self.profile = profile
         self._emu = emu = DriverEmulation(sim, profile)
         self._lock = lock
@@ -86,7 +88,7 @@ class EmulatedDriver:
         #: Under the lock: why a command to a controller does not move the arm now ("" = it does).
         self.refusal: Callable[[str], str] = emu.refusal
         self._tf_msg = TFMessage(transforms=[TransformStamped() for _ in profile.tf])
-        prefix = for_this_node()
+        prefix = prefix or TfPrefix()
         for t, spec in zip(self._tf_msg.transforms, profile.tf, strict=True):
             t.header.frame_id, t.child_frame_id = prefix.add(spec.parent), prefix.add(spec.child)
         self._scaling_msg = Float64(1.0)
