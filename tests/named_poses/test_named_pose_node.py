@@ -160,6 +160,43 @@ def test_a_request_before_the_first_joint_state_waits_for_it_or_says_which_topic
         assert answer.success, answer.message
 
 
+def test_a_trajectory_waits_for_the_drivers_subscription_or_the_move_is_refused_naming_the_topic(stack):
+    """A trajectory published before the driver's subscription has connected (right after start-up) is lost
+    and the arm would not move at all: the move waits up to `~state_wait` for a subscriber, else refuses."""
+    import rospy
+    from compliant_control_msgs.srv import MoveToNamedPose
+    from rospkg import RosPack
+    from trajectory_msgs.msg import JointTrajectory
+
+    topic = "/late_driver/command"
+    params = {"config": RosPack().get_path("ur5_custom") + "/config/named_poses.yaml",
+              "joint_states_topic": "/joint_states", "trajectory_topic": topic, "state_wait": 1.0,
+              "settle_time": 0.2}
+    with run_node("named_poses", "named_pose_server", params=params, name="late_poses") as node:
+        node.wait_for_service("/late_poses/move_to", timeout=30)
+        move_to = rospy.ServiceProxy("/late_poses/move_to", MoveToNamedPose)
+        refused = move_to(name="home", speed_scale=1.0)
+        assert not refused.success
+        assert f"nothing subscribes to {topic} within 1 s" in refused.message, refused.message
+
+        got: list[JointTrajectory] = []
+        subs: list[rospy.Subscriber] = []
+        answered = threading.Event()
+
+        def subscribe_late() -> None:  # the driver's subscription connects 0.3 s after the request
+            if not answered.wait(0.3):
+                subs.append(rospy.Subscriber(topic, JointTrajectory, got.append))
+
+        threading.Thread(target=subscribe_late, daemon=True).start()
+        try:
+            move_to(name="home", speed_scale=1.0)  # nothing moves the arm here: the answer is "did not reach"
+        finally:
+            answered.set()
+            for sub in subs:
+                sub.unregister()
+        assert len(got) == 1 and got[0].points, "the trajectory reached the late subscriber"
+
+
 def test_a_jog_held_during_a_move_is_paused_for_it_and_resumed_after(stack):
     """A key held down in keyboard.launch (twists streaming into jog_arm) while move_to runs: jog_arm's joint
     commands would replace the trajectory (the arm stayed 0.3 rad from the pose: "did not reach"). named_poses

@@ -134,7 +134,9 @@ class FollowServer:
         except SwitchError as exc:
             return R.INVALID_GOAL, f"refused: {exc}{poses._resume_jog(paused)}"
         try:
-            code, why = self._follow(plan, current, start, goal.trajectory.header.stamp)
+            silent = poses.trajectory_listener()
+            code, why = ((R.INVALID_GOAL, f"refused: {silent}") if silent else
+                         self._follow(plan, current, start, goal.trajectory.header.stamp))
         finally:
             if switch is not None:
                 poses._switch(switch.undo())

@@ -259,7 +259,8 @@ class NamedPoseServer:
                 return self._refuse(str(exc) + self._resume_jog(paused))
         back = _Switched(True, "")
         try:
-            answer = self._move(name, goal, move.duration, msg)
+            silent = self.trajectory_listener() if move.duration > 0.0 else ""
+            answer = self._refuse(silent) if silent else self._move(name, goal, move.duration, msg)
         finally:
             if switch is not None:
                 back = self._switch(switch.undo())
@@ -294,6 +295,18 @@ class NamedPoseServer:
             return (f"no joint state for {list(self.poses.joints)} within {self.state_wait:g} s "
                     f"(is the driver publishing {self._states_topic}?)"), None
         return "", current
+
+    def trajectory_listener(self) -> str:
+        """'' once the driver subscribes to the trajectory topic (waiting up to `~state_wait`), else why not:
+        a trajectory published before its subscription has connected (right after start-up, or the
+        controller just switched on) is lost, and the arm would not move at all."""
+        deadline = time.monotonic() + self.state_wait
+        while self._pub.get_num_connections() == 0:
+            if time.monotonic() >= deadline or rospy.is_shutdown():
+                return (f"nothing subscribes to {self._pub.resolved_name} within {self.state_wait:g} s "
+                        "(is the driver's trajectory controller running?)")
+            time.sleep(0.01)
+        return ""
 
     # --- jog_arm pause (README, Jogging during a move) ---
     def _pause_jog(self) -> bool:

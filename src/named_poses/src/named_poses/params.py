@@ -49,7 +49,8 @@ class NamedPoseSettings:
     )
     state_wait: float = param(
         2.0, unit="s", ge=0.0,
-        doc="`~move_to` waits this long for a joint state of every pose joint before it refuses",
+        doc="`~move_to` waits this long for a joint state of every pose joint, and for the driver to "
+            "subscribe to the trajectory topic, before it refuses",
     )
     trajectory_topic: str = param(
         "arm_controller/command", nonempty=True, doc="trajectory_msgs/JointTrajectory output (the driver's)"
