@@ -35,8 +35,8 @@ from mujoco_driver.fixtures import hole_boxes
 from mujoco_driver.meshes import LinkGeometry, prepare_collision
 
 __all__ = [
-    "SceneError", "SceneModel", "UrdfJoint", "build_scene", "mujoco_urdf", "mujoco_urdf_report",
-    "rpy_to_quat", "surface_top", "surface_truth", "urdf_joints",
+    "ArmSpec", "SceneError", "SceneModel", "UrdfJoint", "arm_spec", "build_scene", "index_scene",
+    "mujoco_urdf", "mujoco_urdf_report", "rpy_to_quat", "surface_top", "surface_truth", "urdf_joints",
 ]
 
 _log = logging.getLogger(__name__)
@@ -217,6 +217,7 @@ class SceneModel:
         eef_body: Body id of the end-effector frame link.
         payload_mass: Mass below the sensor [kg].
         geometry: What became of each link's collision geometry (kept, converted, fitted primitive, none).
+        prefix: The arm's name prefix in a world of several arms (mujoco_driver.cell); '' alone.
     """
 
     model: mujoco.MjModel
@@ -238,6 +239,7 @@ class SceneModel:
     eef_body: int
     payload_mass: float
     geometry: list[LinkGeometry] = field(default_factory=list)
+    prefix: str = ""
 
 
 def _subtree(root: mujoco.MjsBody) -> list[mujoco.MjsBody]:
@@ -371,6 +373,22 @@ def _overlapping_links(
     return sorted((body(a), body(b)) for a, b in always or set() if not {body(a), body(b)} & measured)
 
 
+@dataclass
+class ArmSpec:
+    """One arm's scene before it is placed in a world: the spec (compiled once, checked) and what indexing
+    its compiled model needs (:func:`index_scene`)."""
+
+    spec: mujoco.MjSpec
+    model: mujoco.MjModel
+    cfg: SceneConfig
+    names: list[str]
+    arm_names: list[str]
+    start: np.ndarray
+    max_acceleration: np.ndarray
+    velocity: list[float | None]
+    geometry: list[LinkGeometry]
+
+
 def build_scene(urdf_xml: str, cfg: SceneConfig, mesh_cache: str | None = None) -> SceneModel:
     """Compile the scene.
 
@@ -389,6 +407,16 @@ def build_scene(urdf_xml: str, cfg: SceneConfig, mesh_cache: str | None = None) 
     Raises:
         SceneError: If MuJoCo rejects the URDF, a named link is missing, a joint is not a 1-DoF hinge or
             slide, or a per-joint setting does not match the URDF's joints.
+    """
+    arm = arm_spec(urdf_xml, cfg, mesh_cache)
+    return index_scene(arm.model, arm)
+
+
+def arm_spec(urdf_xml: str, cfg: SceneConfig, mesh_cache: str | None = None) -> ArmSpec:
+    """The arm's scene (:func:`build_scene`), compiled alone and checked, ready to be placed in a world.
+
+    Raises:
+        SceneError: As :func:`build_scene`.
     """
     limits = urdf_joints(urdf_xml)
     mjcf_urdf, geometry = mujoco_urdf_report(urdf_xml, mesh_cache)
@@ -469,33 +497,44 @@ def build_scene(urdf_xml: str, cfg: SceneConfig, mesh_cache: str | None = None) 
             model = spec.compile()
     except ValueError as exc:
         raise SceneError(f"MuJoCo cannot compile the scene: {exc}") from exc
+    vel = [limits[n].velocity if n in limits and limits[n].velocity else np.inf for n in names]
+    return ArmSpec(spec, model, cfg, names, arm_names, start, max_acceleration, vel, geometry)
 
-    jids = [model.joint(n).id for n in names]
+
+def index_scene(model: mujoco.MjModel, arm: ArmSpec, prefix: str = "") -> SceneModel:
+    """The indices of `arm` in `model`: its own compiled model, or a world it was attached to with `prefix`
+    on its names (mujoco_driver.cell).
+
+    Raises:
+        SceneError: If the start pose is outside the joints' limits.
+    """
+    cfg, names = arm.cfg, arm.names
+    jids = [model.joint(prefix + n).id for n in names]
     lower = np.array([model.jnt_range[j, 0] if model.jnt_limited[j] else -np.inf for j in jids])
     upper = np.array([model.jnt_range[j, 1] if model.jnt_limited[j] else np.inf for j in jids])
-    vel = [limits[n].velocity if n in limits and limits[n].velocity else np.inf for n in names]
-    outside = [n for n, q, lo, hi in zip(names, start, lower, upper, strict=True) if not lo <= q <= hi]
+    outside = [n for n, q, lo, hi in zip(names, arm.start, lower, upper, strict=True) if not lo <= q <= hi]
     if outside:
         raise SceneError(f"start_pose / held_joints: joints {outside} outside their limits")
-    sensor_id = model.body(cfg.links.ft_sensor).id
+    sensor_id = model.body(prefix + cfg.links.ft_sensor).id
     return SceneModel(
         model=model,
-        joint_names=names,
-        arm_index=np.array([names.index(n) for n in arm_names], dtype=np.intp),
+        joint_names=list(names),
+        arm_index=np.array([names.index(n) for n in arm.arm_names], dtype=np.intp),
         qpos_adr=np.array([model.jnt_qposadr[j] for j in jids]),
         dof_adr=np.array([model.jnt_dofadr[j] for j in jids]),
-        ctrl_adr=np.array([model.actuator_ctrladr[model.actuator(f"{n}_servo").id] for n in names]),
+        ctrl_adr=np.array([model.actuator_ctrladr[model.actuator(f"{prefix}{n}_servo").id] for n in names]),
         lower=lower,
         upper=upper,
-        velocity_limit=np.array(vel, dtype=float),
-        max_acceleration=max_acceleration,
-        start_pose=start,
-        ft_site=model.site(FT_SITE).id,
-        force_adr=int(model.sensor_adr[model.sensor(FORCE_SENSOR).id]),
-        torque_adr=int(model.sensor_adr[model.sensor(TORQUE_SENSOR).id]),
+        velocity_limit=np.array(arm.velocity, dtype=float),
+        max_acceleration=arm.max_acceleration,
+        start_pose=arm.start,
+        ft_site=model.site(prefix + FT_SITE).id,
+        force_adr=int(model.sensor_adr[model.sensor(prefix + FORCE_SENSOR).id]),
+        torque_adr=int(model.sensor_adr[model.sensor(prefix + TORQUE_SENSOR).id]),
         sensor_body=sensor_id,
-        tool_body=model.body(cfg.links.tool).id,
-        eef_body=model.body(cfg.links.eef).id,
+        tool_body=model.body(prefix + cfg.links.tool).id,
+        eef_body=model.body(prefix + cfg.links.eef).id,
         payload_mass=float(model.body_subtreemass[sensor_id]),
-        geometry=geometry,
+        geometry=arm.geometry,
+        prefix=prefix,
     )

@@ -77,10 +77,41 @@ class Simulation:
         self, urdf_xml: str, scene_cfg: SceneConfig | Mapping[str, Any], mesh_cache: str | None = None
     ) -> None:
         cfg = scene_cfg if isinstance(scene_cfg, SceneConfig) else SceneConfig.from_dict(scene_cfg)
+        scene = build_scene(urdf_xml, cfg, mesh_cache)
+        self._bind(cfg, scene, mujoco.MjData(scene.model), None)
+        self.reset()
+
+    @classmethod
+    def in_world(cls, world: Any, cfg: SceneConfig, scene: SceneModel, base: np.ndarray) -> Simulation:
+        """One arm of a world of several (mujoco_driver.cell.World, which steps and resets them all).
+
+        Args:
+            world: The world; this arm's :meth:`step` steps it.
+            cfg: The arm's scene settings.
+            scene: The arm's indices in the world's model (its names carry ``scene.prefix``).
+            base: The arm's base frame in the world: x, y, z [m], qw, qx, qy, qz.
+        """
+        sim = cls.__new__(cls)
+        sim._bind(cfg, scene, world.data, base)
+        sim._world = world
+        return sim
+
+    def _bind(
+        self, cfg: SceneConfig, scene: SceneModel, data: mujoco.MjData, base: np.ndarray | None
+    ) -> None:
         self.config = cfg
-        self.scene: SceneModel = build_scene(urdf_xml, cfg, mesh_cache)
-        self.model = self.scene.model
-        self.data = mujoco.MjData(self.model)
+        self.scene = scene
+        self.model = scene.model
+        self.data = data
+        self._world: Any = None
+        # The base frame in MuJoCo's world: None when they are one (an arm alone); poses, the sensor's
+        # rotation and pushes are turned between them.
+        self._base = None if base is None else (np.asarray(base[:3], float), np.asarray(base[3:], float))
+        self._base_R, self._base_conj = np.eye(3), np.zeros(4)
+        if base is not None:
+            quat = np.asarray(base[3:], float)
+            mujoco.mju_quat2Mat(self._base_R.reshape(9), quat)
+            mujoco.mju_negQuat(self._base_conj, quat)
         self.joint_names: tuple[str, ...] = tuple(self.scene.joint_names)
         # The joints velocity commands address (every joint but the held ones), in joint_names order.
         self.arm_joint_names: tuple[str, ...] = tuple(self.joint_names[i] for i in self.scene.arm_index)
@@ -93,7 +124,7 @@ class Simulation:
         self._measured = {b for b in range(self.model.nbody) if self._below(b, sc.sensor_body, parents)}
         self._pos_ctrl, self._vel_ctrl, self._ff_ctrl = sc.ctrl_adr, sc.ctrl_adr + 1, sc.ctrl_adr + 2
         # The servos' controls as a (joint, [position, velocity, torque]) view when the scene lays them out
-        # that way (it does, joint by joint, and the dofs in joint order): strided copies instead of fancy
+        # that way (an arm alone: joint by joint, the dofs in joint order): strided copies instead of fancy
         # indexing, ~5 us less per step.
         regular = (self.model.nu == 3 * n and np.array_equal(sc.ctrl_adr, 3 * np.arange(n))
                    and np.array_equal(sc.dof_adr, np.arange(n)))
@@ -120,8 +151,8 @@ class Simulation:
         self._traj_seg = 0
         self._push_steps = 0
         self._push_wrench = np.zeros(6)
+        self._push_world = np.zeros(6)
         self._rng = np.random.default_rng(cfg.wrench_noise.seed)
-        self.reset()
 
     @staticmethod
     def _below(body: int, root: int, parents: np.ndarray) -> bool:
@@ -211,8 +242,24 @@ class Simulation:
 
     def link_pose(self, body_id: int) -> tuple[np.ndarray, np.ndarray]:
         """Pose of a body in the base frame: (position [m], quaternion x, y, z, w)."""
-        quat = self.data.xquat[body_id]
-        return self.data.xpos[body_id].copy(), np.array([quat[1], quat[2], quat[3], quat[0]])
+        pos, quat = self.data.xpos[body_id].copy(), self.data.xquat[body_id]
+        if self._base is not None:
+            pos = self._base_R.T @ (pos - self._base[0])
+            local = np.zeros(4)
+            mujoco.mju_mulQuat(local, self._base_conj, quat)
+            quat = local
+        return pos, np.array([quat[1], quat[2], quat[3], quat[0]])
+
+    def world_pose(
+        self, pos: np.ndarray, quat: np.ndarray, out_pos: np.ndarray, out_quat: np.ndarray
+    ) -> None:
+        """A MuJoCo world pose (position, quaternion w, x, y, z) in the base frame, written into the outs."""
+        if self._base is None:
+            out_pos[:], out_quat[:] = pos, quat
+            return
+        np.subtract(pos, self._base[0], out=out_pos)
+        out_pos[:] = self._base_R.T @ out_pos
+        mujoco.mju_mulQuat(out_quat, self._base_conj, quat)
 
     def eef_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """End-effector frame (``links.eef``) in the base frame: (position [m], quaternion x, y, z, w)."""
@@ -220,7 +267,7 @@ class Simulation:
 
     def sensor_rotation(self) -> np.ndarray:
         """Rotation matrix of the F/T sensor frame in the base frame (3x3 copy)."""
-        return self.data.site_xmat[self.scene.ft_site].reshape(3, 3).copy()
+        return self._base_R.T @ self.data.site_xmat[self.scene.ft_site].reshape(3, 3)
 
     def tool_contacts(self) -> set[str]:
         """Names of the geoms (or their bodies, if unnamed) the sensor's subtree touches now."""
@@ -231,7 +278,8 @@ class Simulation:
             other = contact.geom[1] if b1 in measured else contact.geom[0] if b2 in measured else -1
             if other >= 0:
                 name = model.geom(other).name or model.body(model.geom_bodyid[other]).name
-                touched.add(name)
+                prefix = self.scene.prefix  # this arm's own environment by its own names
+                touched.add(name[len(prefix):] if prefix and name.startswith(prefix) else name)
         return touched
 
     def warnings(self) -> dict[str, int]:
@@ -345,13 +393,27 @@ class Simulation:
             raise CommandError(f"push: duration must be >= 0 s, got {duration}")
         self._push_steps = round(duration / self.dt)
         self._push_wrench[:] = wrench
-        self.data.xfrc_applied[self.scene.tool_body] = wrench if self._push_steps else 0.0
+        self._push_world[:3], self._push_world[3:] = self._base_R @ wrench[:3], self._base_R @ wrench[3:]
+        self.data.xfrc_applied[self.scene.tool_body] = self._push_world if self._push_steps else 0.0
 
     def reset(self) -> None:
-        """Back to the start pose at time 0, at rest, holding position, no push."""
-        model, data, sc = self.model, self.data, self.scene
-        mujoco.mj_resetData(model, data)
+        """Back to the start pose at time 0, at rest, holding position, no push. An arm in a world goes back
+        alone: the world's time and the other arms go on."""
+        model, data = self.model, self.data
+        if self._world is None:
+            mujoco.mj_resetData(model, data)
+        else:
+            data.qvel[self.scene.dof_adr] = 0.0
+            data.qacc_warmstart[self.scene.dof_adr] = 0.0
+        self._reset_arm()
+        mujoco.mj_forward(model, data)  # kinematics of the start pose, for the payload feed-forward
+        self._write_controls()
+        mujoco.mj_forward(model, data)  # sensors see the servo holding the start pose
+
+    def _reset_arm(self) -> None:
+        sc, data = self.scene, self.data
         data.qpos[sc.qpos_adr] = sc.start_pose
+        data.xfrc_applied[sc.tool_body] = 0.0
         self._goal[:] = sc.start_pose
         self._q_target[:] = sc.start_pose
         self._qd_target[:] = 0.0
@@ -359,26 +421,32 @@ class Simulation:
         self._mode, self._traj = MODE_POSITION, None
         self._push_steps = 0
         self._rng = np.random.default_rng(self.config.wrench_noise.seed)
-        mujoco.mj_forward(model, data)  # kinematics of the start pose, for the payload feed-forward
-        self._write_controls()
-        mujoco.mj_forward(model, data)  # sensors see the servo holding the start pose
 
     # ---------------------------------------------------------------- stepping
     def step(self, n: int = 1) -> None:
-        """Advance ``n`` timesteps."""
+        """Advance ``n`` timesteps (an arm in a world: the whole world)."""
+        if self._world is not None:
+            self._world.step(n)
+            return
         model, data = self.model, self.data
         for _ in range(n):
-            self._update_setpoint()
-            self._write_controls()
-            if self._push_steps:  # every step: the viewer's sync() zeroes xfrc_applied (its mouse channel)
-                data.xfrc_applied[self.scene.tool_body] = self._push_wrench
+            self._before_step()
             mujoco.mj_step2(model, data)
-            if self._push_steps:
-                self._push_steps -= 1
-                if not self._push_steps:
-                    data.xfrc_applied[self.scene.tool_body] = 0.0
+            self._after_step()
             # Position stage for the new state, so poses and qpos always agree between calls.
             mujoco.mj_step1(model, data)
+
+    def _before_step(self) -> None:
+        self._update_setpoint()
+        self._write_controls()
+        if self._push_steps:  # every step: the viewer's sync() zeroes xfrc_applied (its mouse channel)
+            self.data.xfrc_applied[self.scene.tool_body] = self._push_world
+
+    def _after_step(self) -> None:
+        if self._push_steps:
+            self._push_steps -= 1
+            if not self._push_steps:
+                self.data.xfrc_applied[self.scene.tool_body] = 0.0
 
     def _write_controls(self) -> None:
         ctrl3 = self._ctrl3
