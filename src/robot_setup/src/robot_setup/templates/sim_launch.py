@@ -28,6 +28,7 @@ def sim_launch(plan: Plan) -> str:
   <arg name="with_jog_arm" default="true" doc="start jog_arm_server"/>
   <arg name="with_contact_control" default="true" doc="start contact_control_node"/>
   <arg name="single_process" default="true" doc="contact_control and jog_arm in one process (control_stack_node), one hop less"/>
+  <arg name="with_driver" default="true" doc="false: no driver of its own, only its parameters (a cell's one world simulates this robot: mujoco_driver README, Cells)"/>
   <arg name="publish_synchronously" default="true" doc="the driver writes subscribers' sockets in its loop"/>
   <arg name="fixture" default="none" doc="hole: a plate with a square, chamfered hole on the block; hand: a person's hand (ISO/TS 15066) lying on it; tilted: the block's top tilted 15 degrees; cylinder, sphere: a curved part in the block's place (mujoco_driver README, Fixtures)"/>
   <arg name="hole_offset" default="[0.0, 0.0, 0.0]" doc="the hole's offset from its nominal pose '[dx, dy, yaw]' [m, m, rad]"/>
@@ -52,6 +53,7 @@ def sim_launch(plan: Plan) -> str:
     <arg name="with_jog_arm" value="$(arg with_jog_arm)"/>
     <arg name="with_contact_control" value="$(arg with_contact_control)"/>
     <arg name="single_process" value="$(arg single_process)"/>
+    <arg name="with_driver" value="$(arg with_driver)"/>
     <arg name="publish_synchronously" value="$(arg publish_synchronously)"/>
     <arg name="fixture" value="$(arg fixture)"/>
     <arg name="hole_offset" value="$(arg hole_offset)"/>

@@ -1,0 +1,129 @@
+"""mujoco_cell node: one MuJoCo world with every arm of a cell, each under its namespace (README, Cells).
+
+Each arm's parameters are where its own driver's would be (``/<arm>/mujoco_driver/``, set by its robot
+package's sim.launch with ``with_driver:=false``), its description at ``/<arm>/robot_description``, its tf
+prefix at ``/<arm>/tf_prefix``; the cell node's ``~arms`` lists the arms and their base poses in the world.
+The loop's settings (real-time factor, /clock, lockstep wait) are the first arm's; ``~viewer`` opens
+MuJoCo's window on the whole cell.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import signal
+import sys
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import rospy
+from compliant_common.runtime import tune_runtime
+from compliant_common.tf_prefix import TfPrefix
+
+from mujoco_driver.cell import CellArm, World
+from mujoco_driver.cell_file import triple
+from mujoco_driver.config import ConfigError
+from mujoco_driver.node import ArmSetup, MujocoDriverNode
+from mujoco_driver.params import DriverParamError, DriverSettings, load_scene, urdf_root_link
+from mujoco_driver.ros_arm_port import PortNames
+from mujoco_driver.scene import SceneError
+
+__all__ = ["CellParamError", "main", "read_arms"]
+
+DRIVER_NAME = "mujoco_driver"  # each arm's driver node name, under its namespace
+
+
+class CellParamError(DriverParamError):
+    """A bad ``~arms`` entry or an arm's parameters missing."""
+
+
+def read_arms(entries: Any) -> list[tuple[str, tuple[float, float, float], tuple[float, float, float]]]:
+    """`~arms` as (name, position [m], rpy [rad]) per arm.
+
+    Raises:
+        CellParamError: Not a list of mappings with a `name`, an unknown key, or a bad position or rpy.
+    """
+    if not isinstance(entries, list) or not entries:
+        raise CellParamError(f"~arms: expected a list of {{name, position, rpy}}, got {entries!r}")
+    arms = []
+    for i, entry in enumerate(entries):
+        where = f"~arms[{i}]"
+        if not isinstance(entry, Mapping) or not isinstance(entry.get("name"), str) or not entry["name"]:
+            raise CellParamError(f"{where}: expected a mapping with a name (the arm's namespace), got "
+                                 f"{entry!r}")
+        unknown = sorted(set(entry) - {"name", "position", "rpy"})
+        if unknown:
+            raise CellParamError(f"{where}: unknown keys {unknown} (known: name, position, rpy)")
+        arms.append((entry["name"].strip("/"), triple(entry, "position", where, CellParamError),
+                     triple(entry, "rpy", where, CellParamError)))
+    return arms
+
+
+def _arm(name: str, use_sim_time: bool) -> tuple[DriverSettings, str, TfPrefix]:
+    """An arm's driver settings, description and tf prefix from its namespace."""
+    params = rospy.get_param(f"/{name}/{DRIVER_NAME}", None)
+    if not isinstance(params, dict):
+        raise CellParamError(f"arm {name}: no parameters at /{name}/{DRIVER_NAME} (start its robot package's "
+                             "sim.launch with ns:={name} with_driver:=false)")
+    try:
+        settings = DriverSettings.from_params(params, use_sim_time=use_sim_time)
+    except DriverParamError as exc:
+        raise CellParamError(f"arm {name}: {exc}") from None
+    if settings.profile:
+        raise CellParamError(f"arm {name}: ~profile {settings.profile!r}: a cell's arms speak this driver's "
+                             "own interface")
+    key = f"/{name}/{DRIVER_NAME}/robot_description"
+    key = key if rospy.has_param(key) else f"/{name}/robot_description"
+    if not rospy.has_param(key):
+        raise CellParamError(f"arm {name}: /{name}/robot_description is not set (the URDF)")
+    return settings, rospy.get_param(key), TfPrefix(str(rospy.get_param(f"/{name}/tf_prefix", "")))
+
+
+def build(arms: Sequence[tuple[str, tuple[float, float, float], tuple[float, float, float]]],
+          viewer: bool) -> MujocoDriverNode:
+    """The node serving `arms` in one world.
+
+    Raises:
+        CellParamError, DriverParamError, ConfigError, SceneError: Naming the arm and the key.
+    """
+    use_sim_time = bool(rospy.get_param("/use_sim_time", False))
+    found = []
+    for name, position, rpy in arms:
+        settings, urdf, tf = _arm(name, use_sim_time)
+        try:
+            scene = load_scene(settings)
+        except (DriverParamError, ConfigError) as exc:
+            raise CellParamError(f"arm {name}: {exc}") from None
+        found.append((name, settings, urdf, tf, scene, CellArm(name, urdf, scene, position, rpy)))
+    world = World([f[-1] for f in found])
+    setups = [ArmSetup(settings, world.arms[name], scene, settings.base_frame or urdf_root_link(urdf),
+                       PortNames(f"/{name}/{DRIVER_NAME}", f"/{name}"), tf)
+              for name, settings, urdf, tf, scene, _ in found]
+    loop = dataclasses.replace(found[0][1], viewer=viewer)
+    return MujocoDriverNode(loop, world, setups)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``mujoco_cell`` executable."""
+    rospy.init_node("mujoco_cell", argv=argv if argv is not None else sys.argv, disable_signals=True)
+    node: MujocoDriverNode | None = None
+    stop_early = []
+
+    def on_signal(_signum: int, _frame: Any) -> None:  # as mujoco_driver's: the loop stops, then ROS
+        if node is not None:
+            node.stop()
+        else:
+            stop_early.append(True)
+
+    signal.signal(signal.SIGINT, on_signal)
+    signal.signal(signal.SIGTERM, on_signal)
+    try:
+        node = build(read_arms(rospy.get_param("~arms", None)), bool(rospy.get_param("~viewer", False)))
+    except (DriverParamError, ConfigError, SceneError) as exc:
+        rospy.logfatal("mujoco_cell: %s", exc)
+        rospy.signal_shutdown("bad configuration")
+        return 1
+    tune_runtime(node.dt, switch_fraction=0.25)
+    if not stop_early:
+        node.run()
+    rospy.signal_shutdown("stopped")
+    return 0

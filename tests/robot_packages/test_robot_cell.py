@@ -1,0 +1,100 @@
+"""A cell (mujoco_driver README, *Cells*): the UR5 as `left` and the Panda as `right` in one MuJoCo world, one
+`mujoco_cell` node serving both under their namespaces. Nothing of either stack is outside its namespace,
+each arm jogs on its own commands only, and both run demonstrations at the same time."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import time
+import xmlrpc.client
+
+import numpy as np
+import pytest
+
+pytest.importorskip("compliant_control_msgs.msg", reason="needs devel/setup.bash (make test sources it)")
+
+from geometry_msgs.msg import PoseStamped, TwistStamped
+from harness.launch import run_node
+from harness.waiting import Collector, wait_until
+from rospkg import RosPack
+
+pytestmark = pytest.mark.cell
+
+ROBOTS = {"left": ("ur5", "base_link"), "right": ("panda", "panda_link0")}
+SHARED = {"/rosout", "/rosout_agg", "/tf", "/tf_static", "/diagnostics", "/use_sim_time"}
+
+
+def _master() -> xmlrpc.client.ServerProxy:
+    return xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"])
+
+
+def _ours(name: str) -> bool:
+    return any(name.startswith(f"/{ns}/") for ns in ROBOTS)
+
+
+def _position(c: Collector) -> np.ndarray:
+    p = c.last().pose.position
+    return np.array([p.x, p.y, p.z])
+
+
+@pytest.fixture(scope="module")
+def cell(ros_node):
+    path = RosPack().get_path("mujoco_driver") + "/config/cells/ur5_panda.yaml"
+    with run_node("mujoco_driver", "cell", args=[path, "--wait"]) as launched:
+        for ns in ROBOTS:
+            launched.wait_for_service(f"/{ns}/configure_laws", timeout=120)
+            launched.wait_for_service(f"/{ns}/mujoco_driver/reset", timeout=60)
+        yield launched
+
+
+def test_one_world_serves_each_arm_under_its_name_and_each_jogs_alone(cell, ros_node):
+    rospy = ros_node
+    publishers, subscribers, services = _master().getSystemState("/test")[2]
+    nodes = {n for _, ns in [*publishers, *subscribers, *services] for n in ns}
+    assert "/mujoco_cell" in nodes, sorted(nodes)
+    assert not any(n.endswith("/mujoco_driver") for n in nodes), sorted(nodes)
+    served = {name for name, ns in [*publishers, *services] if "/mujoco_cell" in ns}
+    loose = sorted(n for n in served
+                   if n not in SHARED and not _ours(n) and not n.startswith("/mujoco_cell/"))
+    assert not loose, f"the cell's names outside the arms' namespaces: {loose}"
+    for ns in ROBOTS:
+        assert f"/{ns}/joint_states" in served and f"/{ns}/wrench" in served
+    poses = {ns: Collector(f"/{ns}/mujoco_driver/eef_pose", PoseStamped) for ns in ROBOTS}
+    for ns, c in poses.items():
+        assert c.wait_for(5, timeout=20)[-1].header.frame_id.startswith(f"{ns}/")
+
+    for ns in ROBOTS:  # only the jogged arm moves: the world is shared, the commands are not
+        start = {n: _position(c) for n, c in poses.items()}
+        pub = rospy.Publisher(f"/{ns}/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1)
+        wait_until(lambda pub=pub: pub.get_num_connections() > 0, 10, f"{ns}'s jog_arm to subscribe")
+        twist = TwistStamped()
+        twist.header.frame_id = f"{ns}/{ROBOTS[ns][1]}"
+        twist.twist.linear.z = 0.02
+        began = rospy.get_time()
+        while rospy.get_time() - began < 1.0:
+            twist.header.stamp = rospy.Time.now()
+            pub.publish(twist)
+            time.sleep(0.01)  # the sender's rate, as key_to_twist's repeat
+        pub.unregister()
+        moved = {n: _position(c) - start[n] for n, c in poses.items()}
+        other = next(n for n in ROBOTS if n != ns)
+        assert moved[ns][2] > 0.01, f"{ns} moved {moved[ns] * 1e3} mm on its 20 mm/s jog up"
+        assert np.linalg.norm(moved[other]) < 0.001, f"{other} moved {moved[other] * 1e3} mm on {ns}'s jog"
+    for c in poses.values():
+        c.close()
+
+
+def test_both_arms_pass_demonstrations_at_the_same_time(cell, tmp_path):
+    runs = {}
+    for ns, (robot, _) in ROBOTS.items():
+        env = dict(os.environ, ROS_NAMESPACE=f"/{ns}", ROS_HOME=str(tmp_path / ns))
+        runs[ns] = subprocess.Popen(
+            ["rosrun", "thesis_demos", "run_demos", "--robot", robot, "--only", "follower_z", "spring_x",
+             "--output", str(tmp_path / ns)],
+            env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    for ns, run in runs.items():
+        out, _ = run.communicate(timeout=400)
+        assert run.returncode == 0, f"{ns}:\n{out[-4000:]}"
+        assert "[PASS] follower_z" in out and "[PASS] spring_x" in out, f"{ns}:\n{out[-4000:]}"
+    assert cell.proc.poll() is None
