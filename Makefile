@@ -7,6 +7,8 @@ DRIVER_OPTIONS ?=
 HARDWARE_ARGS ?=
 # The ROS master of a driver that runs already, e.g. on the robot's computer (README, Two computers).
 MASTER ?=
+# A cell file (or a name in mujoco_driver/config/cells): its arms in one world, demonstrated at once.
+CELL ?=
 BAG ?=
 ENV := scripts/with_env
 PYTEST_ARGS ?=
@@ -45,10 +47,10 @@ param-tables: build
 	@$(ENV) python -m compliant_common.schema_docs --write
 
 demo: build
-	@$(ENV) python scripts/demo --robot $(ROBOT) $(if $(DRIVER),--driver $(DRIVER)) \
-		$(if $(DRIVER_OPTIONS),--driver-options "$(DRIVER_OPTIONS)") \
+	@$(if $(CELL),$(ENV) python scripts/demo_cell --cell "$(CELL)",$(ENV) python scripts/demo --robot $(ROBOT) \
+		$(if $(DRIVER),--driver $(DRIVER)) $(if $(DRIVER_OPTIONS),--driver-options "$(DRIVER_OPTIONS)") \
 		$(if $(HARDWARE_ARGS),--hardware-args "$(HARDWARE_ARGS)") $(if $(BAG),--bag) \
-		$(if $(MASTER),--master "$(MASTER)")
+		$(if $(MASTER),--master "$(MASTER)"))
 
 # make robot NAME=<name> URDF=<path, or relative to example-robot-data's robots/> TIP=<flange link>
 #   [BASE=<link>] [TOOL_MASS=<kg>] [TOOL_RPY=<roll,pitch,yaw>] [HELD=<joint=position,...>]
