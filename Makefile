@@ -70,6 +70,7 @@ bench: build
 	@$(ENV) python scripts/bench_contact_control
 	@$(ENV) python scripts/bench_jog_arm
 	@$(ENV) python scripts/bench_sim_stack --robot $(ROBOT)
+	@$(ENV) python scripts/bench_cell
 	@$(ENV) python scripts/bench_allocations --robot $(ROBOT)
 
 clean:

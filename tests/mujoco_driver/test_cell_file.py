@@ -58,3 +58,11 @@ def test_the_launch_file_runs_each_arms_stack_in_its_namespace_without_a_driver_
     assert arms == [{"name": "left", "position": [0.0, 0.0, 0.0], "rpy": [0.0, 0.0, 0.0]},
                     {"name": "right", "position": [0.0, 1.6, 0.0], "rpy": [0.0, 0.0, 1.57]}]
     assert node.find("param").get("value") == "true"
+
+
+def test_apart_each_arm_runs_its_own_simulation_and_no_cell_node():
+    root = ET.fromstring(launch_xml(parse_cell(GOOD), {"viewer": "true"}, one_world=False))
+    assert root.find("node") is None
+    for include in root.findall("include"):
+        args = {a.get("name"): a.get("value") for a in include.findall("arg")}
+        assert args["with_driver"] == "true" and args["viewer"] == "true"

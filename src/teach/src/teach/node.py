@@ -6,6 +6,7 @@ Thin over `teach.recorder` and `teach.program`: subscribers keep the latest join
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import sys
 import threading
@@ -268,6 +269,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not robot:
         rospy.logfatal("program_server: no robot name: set ~robot, or robot_description's <robot name>")
         return 1
+    # A robot in a namespace keeps its programs apart: two arms of a cell teach under one ROS_HOME, and a
+    # program recorded on one is refused on the other (README, Programs).
+    ns = rospy.get_namespace().strip("/")
+    if ns:
+        s = dataclasses.replace(s, programs_dir=os.path.join(s.programs_dir, ns))
     node = TeachNode(s, robot, base, tip)
     rospy.on_shutdown(node.shutdown)
     rospy.loginfo("teach: robot %s, tool pose %s in %s, programs in %s", robot, tip, base, node.store.folder)
