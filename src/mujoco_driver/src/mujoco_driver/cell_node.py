@@ -3,8 +3,8 @@
 Each arm's parameters are where its own driver's would be (``/<arm>/mujoco_driver/``, set by its robot
 package's sim.launch with ``with_driver:=false``), its description at ``/<arm>/robot_description``, its tf
 prefix at ``/<arm>/tf_prefix``; the cell node's ``~arms`` lists the arms and their base poses in the world.
-The loop's settings (real-time factor, /clock, lockstep wait) are the first arm's; ``~viewer`` opens
-MuJoCo's window on the whole cell.
+The loop's settings (real-time factor, /clock) are the first arm's, its lockstep wait at most
+CELL_LOCKSTEP_WAIT; ``~viewer`` opens MuJoCo's window on the whole cell.
 """
 
 from __future__ import annotations
@@ -30,6 +30,10 @@ from mujoco_driver.scene import SceneError
 __all__ = ["CellParamError", "main", "read_arms"]
 
 DRIVER_NAME = "mujoco_driver"  # each arm's driver node name, under its namespace
+# [s] wall time: the longest the world waits for one arm's silent stack (README, Lockstep). Every arm's time
+# stops meanwhile, so it stays under the stacks' stale-wrench timeouts (contact_control: 0.19-0.25 s): a
+# dead stack on one arm must not end another arm's contact move (1 s ended the Panda's follower).
+CELL_LOCKSTEP_WAIT = 0.1
 
 
 class CellParamError(DriverParamError):
@@ -98,7 +102,9 @@ def build(arms: Sequence[tuple[str, tuple[float, float, float], tuple[float, flo
     setups = [ArmSetup(settings, world.arms[name], scene, settings.base_frame or urdf_root_link(urdf),
                        PortNames(f"/{name}/{DRIVER_NAME}", f"/{name}"), tf)
               for name, settings, urdf, tf, scene, _ in found]
-    loop = dataclasses.replace(found[0][1], viewer=viewer)
+    first = found[0][1]
+    wait = min(first.lockstep_wait, CELL_LOCKSTEP_WAIT)
+    loop = dataclasses.replace(first, viewer=viewer, lockstep_wait=wait)
     return MujocoDriverNode(loop, world, setups)
 
 
