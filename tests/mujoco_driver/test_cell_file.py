@@ -9,7 +9,8 @@ import yaml
 from mujoco_driver.cell_file import CellFileError, launch_xml, load_cell, parse_cell
 
 GOOD = {"arms": [{"name": "left", "package": "ur5_custom"},
-                 {"name": "right", "package": "panda_custom", "position": [0, 1.6, 0], "rpy": [0, 0, 1.57]}]}
+                 {"name": "right", "package": "panda_custom", "position": [0, 1.6, 0], "rpy": [0, 0, 1.57],
+                  "args": {"fixture": "hand", "single_process": False}}]}
 
 
 def test_the_shipped_cell_loads():
@@ -27,6 +28,8 @@ def test_the_shipped_cell_loads():
     ({"arms": [{"name": "left"}]}, "arms[0].package: expected a name"),
     ({"arms": [{"name": "le ft", "package": "ur5_custom"}]}, "arms[0].name: expected a name"),
     ({"arms": [{"name": "a", "package": "p", "pose": [0, 0, 0]}]}, "arms[0]: unknown keys ['pose']"),
+    ({"arms": [{"name": "a", "package": "p", "args": ["fixture"]}]}, "arms[0].args: expected a mapping"),
+    ({"arms": [{"name": "a", "package": "p", "args": {"ns": "b"}}]}, "arms[0].args: ['ns'] are the cell's"),
     ({"arms": [{"name": "a", "package": "p", "position": [0, 0]}]},
      "arms[0].position: expected three numbers"),
     ({"arms": [{"name": "a", "package": "p"}, {"name": "a", "package": "q"}]},
@@ -44,14 +47,15 @@ def test_an_unreadable_file_is_refused_naming_it(tmp_path):
 
 
 def test_the_launch_file_runs_each_arms_stack_in_its_namespace_without_a_driver_and_one_cell_node():
-    root = ET.fromstring(launch_xml(parse_cell(GOOD), {"viewer": "true", "output": "log", "fixture": "hand"}))
+    root = ET.fromstring(launch_xml(parse_cell(GOOD), {"viewer": "true", "output": "log", "fixture": "none"}))
     includes = root.findall("include")
     assert [i.get("file") for i in includes] == ["$(find ur5_custom)/launch/sim.launch",
                                                  "$(find panda_custom)/launch/sim.launch"]
-    for include, name in zip(includes, ("left", "right"), strict=True):
-        args = {a.get("name"): a.get("value") for a in include.findall("arg")}
-        assert args == {"ns": name, "tf_prefix": name, "with_driver": "false", "output": "log",
-                        "fixture": "hand"}
+    args = [{a.get("name"): a.get("value") for a in include.findall("arg")} for include in includes]
+    common = {"with_driver": "false", "output": "log", "fixture": "none"}
+    assert args[0] == {**common, "ns": "left", "tf_prefix": "left"}
+    assert args[1] == {**common, "ns": "right", "tf_prefix": "right", "fixture": "hand",
+                       "single_process": "false"}
     node = root.find("node")
     assert node is not None and node.get("type") == "mujoco_cell" and node.get("output") == "log"
     arms = yaml.safe_load(node.find("rosparam").text)

@@ -4,37 +4,22 @@ each arm jogs on its own commands only (the demonstrations of both at once: thes
 
 from __future__ import annotations
 
-import os
-import time
-import xmlrpc.client
-
 import numpy as np
 import pytest
 
 pytest.importorskip("compliant_control_msgs.msg", reason="needs devel/setup.bash (make test sources it)")
 
-from geometry_msgs.msg import PoseStamped, TwistStamped
+from geometry_msgs.msg import PoseStamped
 from harness.launch import run_node
-from harness.waiting import Collector, wait_until
+from harness.two_arms import SHARED, Jogger, master, position
+from harness.waiting import Collector
 from rospkg import RosPack
 
 pytestmark = pytest.mark.cell
 
 ROBOTS = {"left": ("ur5", "base_link"), "right": ("panda", "panda_link0")}
-SHARED = {"/rosout", "/rosout_agg", "/tf", "/tf_static", "/diagnostics", "/use_sim_time"}
-
-
-def _master() -> xmlrpc.client.ServerProxy:
-    return xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"])
-
-
 def _ours(name: str) -> bool:
     return any(name.startswith(f"/{ns}/") for ns in ROBOTS)
-
-
-def _position(c: Collector) -> np.ndarray:
-    p = c.last().pose.position
-    return np.array([p.x, p.y, p.z])
 
 
 @pytest.fixture(scope="module")
@@ -49,7 +34,7 @@ def cell(ros_node):
 
 def test_one_world_serves_each_arm_under_its_name_and_each_jogs_alone(cell, ros_node):
     rospy = ros_node
-    publishers, subscribers, services = _master().getSystemState("/test")[2]
+    publishers, subscribers, services = master().getSystemState("/test")[2]
     nodes = {n for _, ns in [*publishers, *subscribers, *services] for n in ns}
     assert "/mujoco_cell" in nodes, sorted(nodes)
     assert not any(n.endswith("/mujoco_driver") for n in nodes), sorted(nodes)
@@ -64,19 +49,11 @@ def test_one_world_serves_each_arm_under_its_name_and_each_jogs_alone(cell, ros_
         assert c.wait_for(5, timeout=20)[-1].header.frame_id.startswith(f"{ns}/")
 
     for ns in ROBOTS:  # only the jogged arm moves: the world is shared, the commands are not
-        start = {n: _position(c) for n, c in poses.items()}
-        pub = rospy.Publisher(f"/{ns}/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1)
-        wait_until(lambda pub=pub: pub.get_num_connections() > 0, 10, f"{ns}'s jog_arm to subscribe")
-        twist = TwistStamped()
-        twist.header.frame_id = f"{ns}/{ROBOTS[ns][1]}"
-        twist.twist.linear.z = 0.02
-        began = rospy.get_time()
-        while rospy.get_time() - began < 1.0:
-            twist.header.stamp = rospy.Time.now()
-            pub.publish(twist)
-            time.sleep(0.01)  # the sender's rate, as key_to_twist's repeat
-        pub.unregister()
-        moved = {n: _position(c) - start[n] for n, c in poses.items()}
+        start = {n: position(c) for n, c in poses.items()}
+        jogger = Jogger(rospy, ns, f"{ns}/{ROBOTS[ns][1]}")
+        jogger.jog(1.0)
+        jogger.close()
+        moved = {n: position(c) - start[n] for n, c in poses.items()}
         other = next(n for n in ROBOTS if n != ns)
         assert moved[ns][2] > 0.01, f"{ns} moved {moved[ns] * 1e3} mm on its 20 mm/s jog up"
         assert np.linalg.norm(moved[other]) < 0.001, f"{other} moved {moved[other] * 1e3} mm on {ns}'s jog"

@@ -8,7 +8,6 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
-import time
 
 import numpy as np
 import pytest
@@ -16,18 +15,14 @@ import pytest
 pytest.importorskip("compliant_control_msgs.msg", reason="needs devel/setup.bash (make test sources it)")
 
 from compliant_control_msgs.msg import ContactControlStatus
-from geometry_msgs.msg import PoseStamped, TwistStamped
+from geometry_msgs.msg import PoseStamped
 from harness.launch import run_node
 from harness.process import node_pid
+from harness.two_arms import Jogger, position, standing_still
 from harness.waiting import Collector, wait_until
 from rospkg import RosPack
 
 pytestmark = pytest.mark.cell
-
-
-def _position(c: Collector) -> np.ndarray:
-    p = c.last().pose.position
-    return np.array([p.x, p.y, p.z])
 
 
 def test_killing_one_arms_stack_halts_it_and_the_other_passes_its_demonstrations(ros_node, tmp_path):
@@ -38,18 +33,7 @@ def test_killing_one_arms_stack_halts_it_and_the_other_passes_its_demonstrations
             cell.wait_for_service(f"/{ns}/configure_laws", timeout=120)
         left = Collector("/left/mujoco_driver/eef_pose", PoseStamped)
         left.wait_for(5, timeout=20)
-        pub = rospy.Publisher("/left/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1)
-        wait_until(lambda: pub.get_num_connections() > 0, 10, "left's jog_arm to subscribe")
-        twist = TwistStamped()
-        twist.header.frame_id = "left/base_link"
-        twist.twist.linear.z = 0.02
-
-        def jog_for(seconds: float) -> None:
-            began = rospy.get_time()
-            while rospy.get_time() - began < seconds:
-                twist.header.stamp = rospy.Time.now()
-                pub.publish(twist)
-                time.sleep(0.01)  # the sender's rate, as key_to_twist's repeat
+        jogger = Jogger(rospy, "left", "left/base_link")
 
         env = dict(os.environ, ROS_NAMESPACE="/right", ROS_HOME=str(tmp_path))
         demos = subprocess.Popen(["rosrun", "thesis_demos", "run_demos", "--robot", "panda", "--only",
@@ -59,22 +43,17 @@ def test_killing_one_arms_stack_halts_it_and_the_other_passes_its_demonstrations
             # The kill lands while the right arm runs a contact move: a world held for the dead stack would
             # starve the right's contact_control of wrenches (its stale timeout) and end the move.
             def right_moving() -> bool:
-                jog_for(0.05)
+                jogger.jog(0.05)
                 status = rospy.wait_for_message("/right/contact_control_node/status", ContactControlStatus, 5)
                 return status.move_active
             wait_until(right_moving, 60, "the right arm's first contact move")
-            jog_for(0.5)
-            killed_at = _position(left)
+            jogger.jog(0.5)
+            killed_at = position(left)
             os.kill(node_pid("/left/control_stack"), signal.SIGKILL)
-            jog_for(1.0)  # the keyboard keeps sending: nothing is left to carry it out
-
-            def still() -> bool:  # the last 0.2 s of simulated poses (100 Hz) within 0.1 mm
-                recent = [m.pose.position for m in left.wait_for(1)[-20:]]
-                return len(recent) == 20 and np.ptp([[p.x, p.y, p.z] for p in recent], axis=0).max() < 1e-4
-
+            jogger.jog(1.0)  # the keyboard keeps sending: nothing is left to carry it out
             left.clear()
-            wait_until(still, 15, "the left arm to stop")
-            coast = float(np.linalg.norm(_position(left) - killed_at))
+            wait_until(lambda: standing_still(left), 15, "the left arm to stop")
+            coast = float(np.linalg.norm(position(left) - killed_at))
             print(f"left arm: {coast * 1e3:.1f} mm from the kill to standstill")
             assert coast < 0.01, f"the left arm ran {coast * 1e3:.1f} mm after its stack died"
             out, _ = demos.communicate(timeout=300)

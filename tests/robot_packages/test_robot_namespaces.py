@@ -8,8 +8,6 @@ import contextlib
 import os
 import signal
 import subprocess
-import time
-import xmlrpc.client
 
 import numpy as np
 import pytest
@@ -17,21 +15,17 @@ import pytest
 pytest.importorskip("compliant_control_msgs.msg", reason="needs devel/setup.bash (make test sources it)")
 
 from compliant_control_msgs.msg import ContactControlStatus
-from geometry_msgs.msg import PoseStamped, TwistStamped
+from geometry_msgs.msg import PoseStamped
 from harness.launch import run_launch
 from harness.process import node_pid
+from harness.two_arms import SHARED, Jogger, master, standing_still
+from harness.two_arms import position as _position
 from harness.waiting import Collector, wait_until
 from tf2_msgs.msg import TFMessage
 
 pytestmark = pytest.mark.cell
 
 ROBOTS = {"left": ("ur5_custom", "base_link"), "right": ("panda_custom", "panda_link0")}
-# What every ROS graph shares by convention: the log, tf (the prefixes keep the frames apart) and diagnostics.
-SHARED = {"/rosout", "/rosout_agg", "/tf", "/tf_static", "/diagnostics", "/use_sim_time"}
-
-
-def _master() -> xmlrpc.client.ServerProxy:
-    return xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"])
 
 
 def _ours(node: str) -> bool:
@@ -39,19 +33,19 @@ def _ours(node: str) -> bool:
 
 
 def _nodes() -> set[str]:
-    publishers, subscribers, services = _master().getSystemState("/test")[2]
+    publishers, subscribers, services = master().getSystemState("/test")[2]
     return {n for _, nodes in [*publishers, *subscribers, *services] for n in nodes}
 
 
 def _names_of_our_nodes() -> set[str]:
     """Every topic and service a node of the two stacks publishes, subscribes or serves."""
-    publishers, subscribers, services = _master().getSystemState("/test")[2]
+    publishers, subscribers, services = master().getSystemState("/test")[2]
     return {name for name, nodes in [*publishers, *subscribers, *services] if any(_ours(n) for n in nodes)}
 
 
 def test_two_robots_share_no_name_and_jog_apart(ros_node):
     rospy = ros_node
-    params_before, nodes_before = set(_master().getParamNames("/test")[2]), _nodes()
+    params_before, nodes_before = set(master().getParamNames("/test")[2]), _nodes()
     with contextlib.ExitStack() as stack:
         launched = {ns: stack.enter_context(run_launch(robot, "sim.launch", args={"ns": ns, "tf_prefix": ns}))
                     for ns, (robot, _) in ROBOTS.items()}
@@ -66,7 +60,7 @@ def test_two_robots_share_no_name_and_jog_apart(ros_node):
         names = _names_of_our_nodes()
         loose = sorted(n for n in names if n not in SHARED and not _ours(n))
         assert not loose, f"names of the two stacks outside their namespaces: {loose}"
-        params = set(_master().getParamNames("/test")[2]) - params_before
+        params = set(master().getParamNames("/test")[2]) - params_before
         loose = sorted(p for p in params
                        if p not in SHARED and not _ours(p) and not p.startswith("/roslaunch"))
         assert not loose, f"parameters outside the namespaces: {loose}"
@@ -87,26 +81,13 @@ def test_two_robots_share_no_name_and_jog_apart(ros_node):
         # jogged arm moves.
         for ns, frame in (("left", "left/base_link"), ("right", "panda_link0")):
             start = {n: _position(c) for n, c in poses.items()}
-            pub = rospy.Publisher(f"/{ns}/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1)
-            wait_until(lambda pub=pub: pub.get_num_connections() > 0, 10, f"{ns}'s jog_arm to subscribe")
-            twist = TwistStamped()
-            twist.header.frame_id = frame
-            twist.twist.linear.z = 0.02
-            began = rospy.get_time()
-            while rospy.get_time() - began < 1.0:
-                twist.header.stamp = rospy.Time.now()
-                pub.publish(twist)
-                time.sleep(0.01)  # the sender's rate, as key_to_twist's repeat
-            pub.unregister()
+            jogger = Jogger(rospy, ns, frame)
+            jogger.jog(1.0)
+            jogger.close()
             moved = {n: float(np.linalg.norm(_position(c) - start[n])) for n, c in poses.items()}
             other = next(n for n in ROBOTS if n != ns)
             assert moved[ns] > 0.01, f"{ns} moved {moved[ns] * 1e3:.1f} mm on its 20 mm jog"
             assert moved[other] < 0.001, f"{other} moved {moved[other] * 1e3:.1f} mm on {ns}'s jog"
-
-
-def _position(c: Collector) -> np.ndarray:
-    p = c.last().pose.position
-    return np.array([p.x, p.y, p.z])
 
 
 def test_killing_one_robots_stack_halts_it_and_the_other_passes_its_demonstrations(ros_node, tmp_path):
@@ -121,32 +102,16 @@ def test_killing_one_robots_stack_halts_it_and_the_other_passes_its_demonstratio
             h.wait_for_service(f"/{ns}/configure_laws", timeout=90)
         left = Collector("/left/mujoco_driver/eef_pose", PoseStamped)
         left.wait_for(5, timeout=20)
-        pub = rospy.Publisher("/left/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1)
-        wait_until(lambda: pub.get_num_connections() > 0, 10, "left's jog_arm to subscribe")
-        twist = TwistStamped()
-        twist.header.frame_id = "left/base_link"
-        twist.twist.linear.z = 0.02
-
-        def jog_for(seconds: float) -> None:
-            began = rospy.get_time()
-            while rospy.get_time() - began < seconds:
-                twist.header.stamp = rospy.Time.now()
-                pub.publish(twist)
-                time.sleep(0.01)  # the sender's rate, as key_to_twist's repeat
-
-        jog_for(0.5)
+        jogger = Jogger(rospy, "left", "left/base_link")
+        jogger.jog(0.5)
         killed_at = _position(left)
         os.kill(node_pid("/left/control_stack"), signal.SIGKILL)
-        jog_for(1.0)  # the keyboard keeps sending: nothing is left to carry it out
-
-        def still() -> bool:  # the last 0.2 s of simulated poses (100 Hz) within 0.1 mm
-            recent = [m.pose.position for m in left.wait_for(1)[-20:]]
-            return len(recent) == 20 and np.ptp([[p.x, p.y, p.z] for p in recent], axis=0).max() < 1e-4
+        jogger.jog(1.0)  # the keyboard keeps sending: nothing is left to carry it out
 
         # The driver first waits for the dead stack (lockstep_wait, wall time), then its command_timeout
         # (0.25 s simulated) stops the arm, as when the stack dies alone.
         left.clear()
-        wait_until(still, 15, "the left arm to stop")
+        wait_until(lambda: standing_still(left), 15, "the left arm to stop")
         coast = float(np.linalg.norm(_position(left) - killed_at))
         print(f"left arm: {coast * 1e3:.1f} mm from the kill to standstill")
         assert coast < 0.01, f"the left arm ran {coast * 1e3:.1f} mm after its stack died"

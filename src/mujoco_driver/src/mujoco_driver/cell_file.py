@@ -2,11 +2,11 @@
 
     arms:
       - {name: left, package: ur5_custom, position: [0, 0, 0], rpy: [0, 0, 0]}
-      - {name: right, package: panda_custom, position: [0, 1.6, 0]}
+      - {name: right, package: panda_custom, position: [0, 1.6, 0], args: {fixture: hand}}
 
 Each arm's whole stack comes from its package's sim.launch in its namespace (``ns:=<name>``, tf prefix
-``<name>``) without a driver of its own; one ``mujoco_cell`` node simulates them all. :func:`launch_xml`
-writes the roslaunch file that does so.
+``<name>``, and its entry's ``args``: that sim.launch's arguments) without a driver of its own; one
+``mujoco_cell`` node simulates them all. :func:`launch_xml` writes the roslaunch file that does so.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from compliant_common.errors import StackError
 __all__ = ["Cell", "CellArmEntry", "CellFileError", "launch_xml", "load_cell", "parse_cell", "triple"]
 
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")  # a ROS name segment
-_KEYS = ("name", "package", "position", "rpy")
+_KEYS = ("name", "package", "position", "rpy", "args")
 
 
 class CellFileError(StackError):
@@ -32,12 +32,14 @@ class CellFileError(StackError):
 
 @dataclass(frozen=True)
 class CellArmEntry:
-    """One arm: its name (namespace and tf prefix), robot package and base pose in the world [m, rad]."""
+    """One arm: its name (namespace and tf prefix), robot package, base pose in the world [m, rad] and its
+    sim.launch's own arguments."""
 
     name: str
     package: str
     position: tuple[float, float, float]
     rpy: tuple[float, float, float]
+    args: tuple[tuple[str, str], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -87,13 +89,27 @@ def parse_cell(data: Any, source: str = "cell") -> Cell:
             if not isinstance(entry.get(key), str) or not _NAME.match(entry[key]):
                 raise CellFileError(f"{where}.{key}: expected a name of letters, digits and _, got "
                                     f"{entry.get(key)!r}")
+        args = entry.get("args", {})
+        scalars = isinstance(args, Mapping) and not any(isinstance(v, Mapping | list) for v in args.values())
+        if not scalars or not all(isinstance(k, str) and _NAME.match(k) for k in args):
+            raise CellFileError(f"{where}.args: expected a mapping of launch arguments to values, got "
+                                f"{args!r}")
+        reserved = sorted(set(args) & {"ns", "tf_prefix", "with_driver"})
+        if reserved:
+            raise CellFileError(f"{where}.args: {reserved} are the cell's to set")
         arms.append(CellArmEntry(entry["name"], entry["package"], triple(entry, "position", where),
-                                 triple(entry, "rpy", where)))
+                                 triple(entry, "rpy", where),
+                                 tuple((k, _launch_value(v)) for k, v in args.items())))
     names = [a.name for a in arms]
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:
         raise CellFileError(f"{source}: arms named {twice} more than once: each arm needs its own namespace")
     return Cell(tuple(arms))
+
+
+def _launch_value(value: Any) -> str:
+    """A YAML scalar as roslaunch reads an argument (true, not True)."""
+    return str(value).lower() if isinstance(value, bool) else str(value)
 
 
 def load_cell(path: str) -> Cell:
@@ -123,7 +139,7 @@ def launch_xml(cell: Cell, args: Mapping[str, str] | None = None, one_world: boo
     for arm in cell.arms:
         lines.append(f'  <include file="$(find {arm.package})/launch/sim.launch">')
         fixed = {"ns": arm.name, "tf_prefix": arm.name, "with_driver": str(not one_world).lower()}
-        for key, value in {**args, **fixed}.items():
+        for key, value in {**args, **dict(arm.args), **fixed}.items():
             lines.append(f"    <arg name={quoteattr(key)} value={quoteattr(value)}/>")
         lines.append("  </include>")
     if not one_world:

@@ -10,22 +10,18 @@ CELL_LOCKSTEP_WAIT; ``~viewer`` opens MuJoCo's window on the whole cell.
 from __future__ import annotations
 
 import dataclasses
-import signal
-import sys
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 import rospy
-from compliant_common.runtime import tune_runtime
 from compliant_common.tf_prefix import TfPrefix
 
 from mujoco_driver.cell import CellArm, World
 from mujoco_driver.cell_file import triple
 from mujoco_driver.config import ConfigError
-from mujoco_driver.node import ArmSetup, MujocoDriverNode
+from mujoco_driver.node import ArmSetup, MujocoDriverNode, serve
 from mujoco_driver.params import DriverParamError, DriverSettings, load_scene, urdf_root_link
 from mujoco_driver.ros_arm_port import PortNames
-from mujoco_driver.scene import SceneError
 
 __all__ = ["CellParamError", "main", "read_arms"]
 
@@ -110,26 +106,5 @@ def build(arms: Sequence[tuple[str, tuple[float, float, float], tuple[float, flo
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``mujoco_cell`` executable."""
-    rospy.init_node("mujoco_cell", argv=argv if argv is not None else sys.argv, disable_signals=True)
-    node: MujocoDriverNode | None = None
-    stop_early = []
-
-    def on_signal(_signum: int, _frame: Any) -> None:  # as mujoco_driver's: the loop stops, then ROS
-        if node is not None:
-            node.stop()
-        else:
-            stop_early.append(True)
-
-    signal.signal(signal.SIGINT, on_signal)
-    signal.signal(signal.SIGTERM, on_signal)
-    try:
-        node = build(read_arms(rospy.get_param("~arms", None)), bool(rospy.get_param("~viewer", False)))
-    except (DriverParamError, ConfigError, SceneError) as exc:
-        rospy.logfatal("mujoco_cell: %s", exc)
-        rospy.signal_shutdown("bad configuration")
-        return 1
-    tune_runtime(node.dt, switch_fraction=0.25)
-    if not stop_early:
-        node.run()
-    rospy.signal_shutdown("stopped")
-    return 0
+    return serve("mujoco_cell", lambda: build(read_arms(rospy.get_param("~arms", None)),
+                                             bool(rospy.get_param("~viewer", False))), argv)

@@ -17,7 +17,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -38,7 +38,7 @@ from mujoco_driver.ros_emulation import resolve_profile
 from mujoco_driver.scene import SceneError
 from mujoco_driver.sim import Simulation
 
-__all__ = ["ArmSetup", "MujocoDriverNode", "main"]
+__all__ = ["ArmSetup", "MujocoDriverNode", "main", "serve"]
 
 # [s] Behind the wall clock by more than this (and a period), the loop steps without publishing until it has
 # caught up. At 500 Hz that is one period, as before; at 1 kHz a 1 ms lag is an ordinary late wake-up on a
@@ -323,13 +323,15 @@ class MujocoDriverNode:
             self._viewer.sync()
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``mujoco_driver`` executable."""
+def serve(name: str, build: Callable[[], MujocoDriverNode], argv: list[str] | None = None,
+          started: Callable[[MujocoDriverNode], None] | None = None) -> int:
+    """Runs a driver node named `name` made by `build` until SIGINT/SIGTERM or a ROS shutdown; 1 if `build`
+    refuses its configuration (logged as fatal)."""
     # rospy's own SIGINT/SIGTERM handler closes every connection inside the signal handler, i.e. in the main
     # thread, which deadlocks when the signal lands while this thread is inside publish() holding a
     # connection's lock (one shutdown in ~10 at 1500 messages/s left the node hanging). Our handler only
     # asks the loop to stop; ROS is shut down afterwards, outside any publish().
-    rospy.init_node("mujoco_driver", argv=argv if argv is not None else sys.argv, disable_signals=True)
+    rospy.init_node(name, argv=argv if argv is not None else sys.argv, disable_signals=True)
     node: MujocoDriverNode | None = None
     stop_early = []
 
@@ -342,31 +344,13 @@ def main(argv: list[str] | None = None) -> int:
     signal.signal(signal.SIGINT, on_signal)
     signal.signal(signal.SIGTERM, on_signal)
     try:
-        params = rospy.get_param("~", {})
-        use_sim_time = bool(rospy.get_param("/use_sim_time", False))
-        settings = DriverSettings.from_params(params, use_sim_time=use_sim_time)  # unknown keys refused
-        # ~robot_description (the simulated robot itself, as an emulated driver has it) wins over the shared
-        # robot_description, which the user's own launch file may load, as on a real cell.
-        key = "~robot_description" if rospy.has_param("~robot_description") else "robot_description"
-        if not rospy.has_param(key):
-            raise DriverParamError(f"{rospy.resolve_name('robot_description')} is not set (the URDF)")
-        urdf = rospy.get_param(key)
-        settings, profile = resolve_profile(settings)  # with ~profile, the real driver's topic names
-        node = MujocoDriverNode.alone(settings, urdf, load_scene(settings), profile)
+        node = build()
     except (DriverParamError, ConfigError, SceneError, ProfileError) as exc:
-        rospy.logfatal("mujoco_driver: %s", exc)
+        rospy.logfatal("%s: %s", name, exc)
         rospy.signal_shutdown("bad configuration")
         return 1
-    if settings.publish_clock and not rospy.get_param("/use_sim_time", False):
-        rospy.logwarn("mujoco_driver: publishing /clock but /use_sim_time is false: other nodes use the wall "
-                      "clock and see stamps in simulated time")
-    # A new master (roscore restarted) gets this node's topics, services and parameters again.
-    MasterWatch(
-        lambda reason: rospy.logerr("mujoco_driver: %s; the arm stops when commands stop (command_timeout)",
-                                    reason),
-        lambda: None,
-        params=["~", "robot_description", "/use_sim_time"],
-    )
+    if started is not None:
+        started(node)
     faulthandler.register(signal.SIGUSR1, all_threads=True)  # `kill -USR1 <pid>`: every thread's stack
     tune_runtime(node.dt, switch_fraction=0.25)
     if not stop_early:
@@ -378,3 +362,36 @@ def main(argv: list[str] | None = None) -> int:
         logging.shutdown()
         os._exit(0)
     return 0
+
+
+def _alone() -> MujocoDriverNode:
+    """The node of the robot in `robot_description`, from the private parameters."""
+    params = rospy.get_param("~", {})
+    use_sim_time = bool(rospy.get_param("/use_sim_time", False))
+    settings = DriverSettings.from_params(params, use_sim_time=use_sim_time)  # unknown keys refused
+    # ~robot_description (the simulated robot itself, as an emulated driver has it) wins over the shared
+    # robot_description, which the user's own launch file may load, as on a real cell.
+    key = "~robot_description" if rospy.has_param("~robot_description") else "robot_description"
+    if not rospy.has_param(key):
+        raise DriverParamError(f"{rospy.resolve_name('robot_description')} is not set (the URDF)")
+    urdf = rospy.get_param(key)
+    settings, profile = resolve_profile(settings)  # with ~profile, the real driver's topic names
+    if settings.publish_clock and not rospy.get_param("/use_sim_time", False):
+        rospy.logwarn("mujoco_driver: publishing /clock but /use_sim_time is false: other nodes use the wall "
+                      "clock and see stamps in simulated time")
+    return MujocoDriverNode.alone(settings, urdf, load_scene(settings), profile)
+
+
+def _watch_master(_node: MujocoDriverNode) -> None:
+    """A new master (roscore restarted) gets this node's topics, services and parameters again."""
+    MasterWatch(
+        lambda reason: rospy.logerr("mujoco_driver: %s; the arm stops when commands stop (command_timeout)",
+                                    reason),
+        lambda: None,
+        params=["~", "robot_description", "/use_sim_time"],
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``mujoco_driver`` executable."""
+    return serve("mujoco_driver", _alone, argv, _watch_master)
