@@ -1,8 +1,8 @@
 """A cell file: which robot packages share one simulated world, where, under which names (README, Cells).
 
     arms:
-      - {name: left, package: ur5_custom, position: [0, 0, 0], rpy: [0, 0, 0]}
-      - {name: right, package: panda_custom, position: [0, 1.6, 0], args: {fixture: hand}}
+      - {name: left, package: big_arm_custom, position: [0, 0, 0], rpy: [0, 0, 0]}
+      - {name: right, package: small_arm_custom, position: [0, 1.6, 0], args: {fixture: hand}}
 
 Each arm's whole stack comes from its package's sim.launch in its namespace (``ns:=<name>``, tf prefix
 ``<name>``, and its entry's ``args``: that sim.launch's arguments) without a driver of its own; one

@@ -28,7 +28,7 @@ __all__ = ["CellParamError", "main", "read_arms"]
 DRIVER_NAME = "mujoco_driver"  # each arm's driver node name, under its namespace
 # [s] wall time: the longest the world waits for one arm's silent stack (README, Lockstep). Every arm's time
 # stops meanwhile, so it stays under the stacks' stale-wrench timeouts (contact_control: 0.19-0.25 s): a
-# dead stack on one arm must not end another arm's contact move (1 s ended the Panda's follower).
+# dead stack on one arm must not end another arm's contact move (1 s ended the other arm's follower move).
 CELL_LOCKSTEP_WAIT = 0.1
 
 
