@@ -11,8 +11,8 @@ pytest.importorskip("compliant_control_msgs.msg", reason="needs devel/setup.bash
 
 from geometry_msgs.msg import PoseStamped
 from harness.launch import run_node
-from harness.two_arms import SHARED, Jogger, master, position
-from harness.waiting import Collector
+from harness.two_arms import SHARED, Jogger, master, position, standing_still
+from harness.waiting import Collector, wait_until
 from rospkg import RosPack
 
 pytestmark = pytest.mark.cell
@@ -49,6 +49,9 @@ def test_one_world_serves_each_arm_under_its_name_and_each_jogs_alone(cell, ros_
         assert c.wait_for(5, timeout=20)[-1].header.frame_id.startswith(f"{ns}/")
 
     for ns in ROBOTS:  # only the jogged arm moves: the world is shared, the commands are not
+        for c in poses.values():  # the previous jog's arm has stopped (its stream's timeout) before
+            c.clear()
+            wait_until(lambda c=c: standing_still(c), 15, "the arms to stand still")
         start = {n: position(c) for n, c in poses.items()}
         jogger = Jogger(rospy, ns, f"{ns}/{ROBOTS[ns][1]}")
         jogger.jog(1.0)

@@ -80,6 +80,9 @@ def test_two_robots_share_no_name_and_jog_apart(ros_node):
         # Jog each arm in turn, the left with its frame's tf name, the right with the bare name: only the
         # jogged arm moves.
         for ns, frame in (("left", "left/base_link"), ("right", "panda_link0")):
+            for c in poses.values():  # the previous jog's arm has stopped (its stream's timeout) before
+                c.clear()
+                wait_until(lambda c=c: standing_still(c), 15, "the arms to stand still")
             start = {n: _position(c) for n, c in poses.items()}
             jogger = Jogger(rospy, ns, frame)
             jogger.jog(1.0)

@@ -115,6 +115,10 @@ class FollowServer:
         return plan
 
     def _run(self, goal: FollowJointTrajectoryGoal) -> tuple[int, str]:
+        with self.poses.listening():
+            return self._run_listening(goal)
+
+    def _run_listening(self, goal: FollowJointTrajectoryGoal) -> tuple[int, str]:
         poses = self.poses
         why, current = poses.ready()  # the same refusals as a named-pose move's
         if current is None:
