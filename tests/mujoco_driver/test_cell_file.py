@@ -70,3 +70,24 @@ def test_apart_each_arm_runs_its_own_simulation_and_no_cell_node():
     for include in root.findall("include"):
         args = {a.get("name"): a.get("value") for a in include.findall("arg")}
         assert args["with_driver"] == "true" and args["viewer"] == "true"
+
+
+@pytest.mark.parametrize("entries, words", [
+    (None, "~arms: expected a list"),
+    ([{"position": [0, 0, 0]}], "~arms[0]: expected a mapping with a name"),
+    ([{"name": "a", "package": "p"}], "~arms[0]: unknown keys ['package']"),
+    ([{"name": "a", "rpy": [0, "x", 0]}], "~arms[0].rpy: expected three numbers"),
+])
+def test_the_cell_nodes_arms_parameter_is_refused_naming_the_entry(entries, words):
+    from mujoco_driver.cell_node import CellParamError, read_arms
+
+    with pytest.raises(CellParamError) as err:
+        read_arms(entries)
+    assert words in str(err.value)
+
+
+def test_the_cell_nodes_arms_parameter_gives_names_and_base_poses():
+    from mujoco_driver.cell_node import read_arms
+
+    assert read_arms([{"name": "/left/", "position": [0, 1, 0]}, {"name": "right", "rpy": [0, 0, 1]}]) == [
+        ("left", (0.0, 1.0, 0.0), (0.0, 0.0, 0.0)), ("right", (0.0, 0.0, 0.0), (0.0, 0.0, 1.0))]

@@ -19,7 +19,7 @@ from compliant_common.tf_prefix import TfPrefix
 from mujoco_driver.cell import CellArm, World
 from mujoco_driver.cell_file import triple
 from mujoco_driver.config import ConfigError
-from mujoco_driver.node import ArmSetup, MujocoDriverNode, serve
+from mujoco_driver.node import ArmSetup, MujocoDriverNode, serve, watch_master
 from mujoco_driver.params import DriverParamError, DriverSettings, load_scene, urdf_root_link
 from mujoco_driver.ros_arm_port import PortNames
 
@@ -106,5 +106,15 @@ def build(arms: Sequence[tuple[str, tuple[float, float, float], tuple[float, flo
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``mujoco_cell`` executable."""
-    return serve("mujoco_cell", lambda: build(read_arms(rospy.get_param("~arms", None)),
-                                             bool(rospy.get_param("~viewer", False))), argv)
+    arms: list = []
+
+    def make() -> MujocoDriverNode:
+        arms.extend(read_arms(rospy.get_param("~arms", None)))
+        return build(arms, bool(rospy.get_param("~viewer", False)))
+
+    def started(_node: MujocoDriverNode) -> None:
+        # A restarted roscore gets every arm's driver parameters and description back, as from its own driver.
+        watch_master(["~", "/use_sim_time", *(f"/{name}/{key}" for name, _, _ in arms
+                                              for key in (DRIVER_NAME, "robot_description"))])
+
+    return serve("mujoco_cell", make, argv, started)

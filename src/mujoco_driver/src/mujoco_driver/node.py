@@ -38,7 +38,7 @@ from mujoco_driver.ros_emulation import resolve_profile
 from mujoco_driver.scene import SceneError
 from mujoco_driver.sim import Simulation
 
-__all__ = ["ArmSetup", "MujocoDriverNode", "main", "serve"]
+__all__ = ["ArmSetup", "MujocoDriverNode", "main", "serve", "watch_master"]
 
 # [s] Behind the wall clock by more than this (and a period), the loop steps without publishing until it has
 # caught up. At 500 Hz that is one period, as before; at 1 kHz a 1 ms lag is an ordinary late wake-up on a
@@ -382,16 +382,17 @@ def _alone() -> MujocoDriverNode:
     return MujocoDriverNode.alone(settings, urdf, load_scene(settings), profile)
 
 
-def _watch_master(_node: MujocoDriverNode) -> None:
-    """A new master (roscore restarted) gets this node's topics, services and parameters again."""
+def watch_master(params: Sequence[str]) -> None:
+    """A new master (roscore restarted) gets this node's topics, services and `params` again."""
     MasterWatch(
         lambda reason: rospy.logerr("mujoco_driver: %s; the arm stops when commands stop (command_timeout)",
                                     reason),
         lambda: None,
-        params=["~", "robot_description", "/use_sim_time"],
+        params=params,
     )
 
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``mujoco_driver`` executable."""
-    return serve("mujoco_driver", _alone, argv, _watch_master)
+    return serve("mujoco_driver", _alone, argv,
+                 lambda _node: watch_master(["~", "robot_description", "/use_sim_time"]))
