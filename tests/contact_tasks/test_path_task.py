@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from contact_tasks.path import PosePath
 from contact_tasks.path_task import PathGoal, PathMetrics, path_task
-from contact_tasks.run import FAILED, SUCCEEDED, TaskRun
+from contact_tasks.run import FAILED, SUCCEEDED, Observation, TaskRun
 from contact_tasks.task import TaskError
 
 from .hole_world import HoleWorld, TaskLoop, tool_down
@@ -68,3 +68,30 @@ def test_a_path_above_nothing_fails_without_contact_and_backs_off():
 def test_a_goal_that_cannot_be_run_is_refused_with_the_field(goal, said):
     with pytest.raises(TaskError, match=said):
         path_task(goal, tool_down(0.0, 0.0, 0.03))
+
+
+def _at_press(force: float) -> tuple[TaskRun, float]:
+    """A path task brought to its press step (to the start and a touch, by hand), then pressed with `force`
+    along the tool's axis from then on; returns the run and when the press began [s]."""
+    tool = tool_down(0.0, 0.0, 0.03)
+    run = TaskRun(path_task(PathGoal([(0, 0, 0, *DOWN), (0.03, 0, 0, *DOWN)], force=10.0), tool),
+                  horizon=0.4, tool_frame="tool_tip")
+    t = 0.0
+    run.start(Observation(t, tool))
+    while run.step_name != "press":
+        t += 0.01
+        run.update(Observation(t, tool, touched=run.step_name == "touch"))
+    return run, t
+
+
+@pytest.mark.parametrize(("force", "after"), [(9.5, 1.5), (8.0, 10.0)])
+def test_the_press_waits_for_the_force_to_build_up_before_the_path(force, after):
+    """90 % of the target held for 1.5 s starts the path (a part that gives way builds the force slowly);
+    short of it the path starts after 10 s anyway."""
+    run, began = _at_press(force)
+    t = began
+    while run.step_name == "press" and t < began + 20.0:
+        t += 0.01
+        run.update(Observation(t, tool_down(0.0, 0.0, 0.0), wrench=(0.0, 0.0, -force, 0.0, 0.0, 0.0)))
+    assert run.step_name == "follow"
+    assert t - began == pytest.approx(after, abs=0.03)

@@ -165,3 +165,26 @@ def test_a_rounded_tool_ends_in_a_ball_at_the_same_tip(run_make_description):
     assert np.allclose(sensor.actInv(tip.translation), [0, 0, 0.12])  # the ball's bottom is the tip
     with pytest.raises(DescriptionError, match="rounded end needs a cylinder"):
         ToolSpec(parent="tool0", shape="box", size=(0.01, 0.01, 0.1), rounded=True).validate()
+
+
+def test_a_plate_tool_hangs_a_square_plate_below_the_tip(run_make_description):
+    """--tool-plate: a square plate hangs centred below the tool's end, its top face at the tip; the tip, mass
+    and centre of mass stay (a bimanual cell's holder)."""
+    result = run_make_description("--source", UR5, *TOOL_ARGS, "--tool-size", "0.03", "0.12",
+                                  "--tool-plate", "0.36")
+    assert result.returncode == 0, result.stderr
+    tool = next(link for link in ET.fromstring(result.stdout).findall("link") if link.get("name") == "tool")
+    boxes = [c for c in tool.findall("collision") if c.find("geometry")[0].tag == "box"]
+    assert len(boxes) == 1 and len(tool.findall("visual")) == 2
+    size = [float(v) for v in boxes[0].find("geometry/box").get("size").split()]
+    centre = [float(v) for v in boxes[0].find("origin").get("xyz").split()]
+    assert size == pytest.approx([0.36, 0.36, 0.01])
+    assert centre == pytest.approx([0.0, 0.0, 0.125])  # its top face (0.12) is the tip
+    assert float(tool.find("inertial/mass").get("value")) == pytest.approx(1.5)
+    model = pin.buildModelFromXML(result.stdout)
+    data = model.createData()
+    pin.framesForwardKinematics(model, data, pin.neutral(model))
+    sensor, tip = data.oMf[model.getFrameId("ft_sensor")], data.oMf[model.getFrameId("tool_tip")]
+    assert np.allclose(sensor.actInv(tip.translation), [0, 0, 0.12])
+    with pytest.raises(DescriptionError, match="plate width"):
+        ToolSpec(parent="tool0", plate=-0.1).validate()

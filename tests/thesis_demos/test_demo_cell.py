@@ -32,3 +32,19 @@ def test_an_unknown_cell_is_refused_naming_the_file(tmp_path):
     command = [str(ROOT / "scripts/with_env"), "python", str(ROOT / "scripts/demo_cell"), "--cell", "no_such"]
     run = subprocess.run(command, capture_output=True, text=True, timeout=120, check=False)
     assert run.returncode == 2 and "no_such.yaml: cannot read" in run.stderr, run.stderr
+
+
+def test_the_cells_bimanual_demonstration_passes_in_its_own_scene(tmp_path):
+    """The ninth demonstration: the UR5 holds the plate on a spring, the Panda presses 10 N on it and slides
+    40 mm; both arms through their own namespaces, one placed in the other's frame through the cell's tf."""
+    command = [str(ROOT / "scripts/with_env"), "python", str(ROOT / "scripts/demo_cell"), "--cell",
+               "ur5_panda", "--only", "bimanual", "--output", str(tmp_path)]
+    with process_slot():
+        run = subprocess.run(command, capture_output=True, text=True, timeout=600, check=False)
+    assert run.returncode == 0, run.stdout[-4000:] + run.stderr[-3000:]
+    assert "left.tool:=plate" in run.stdout and "[PASS] bimanual" in run.stdout
+    for words in ("force while sliding", "plate gave way", "holder back within"):
+        assert any(words in line and line.endswith(" ok") for line in run.stdout.splitlines()), run.stdout
+    folder = tmp_path / "bimanual"
+    assert (folder / "report.md").exists() and (folder / "bimanual.png").exists()
+    assert not (tmp_path / "left").exists()  # no other demonstration ran

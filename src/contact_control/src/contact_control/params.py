@@ -440,6 +440,7 @@ TUNABLE = (
     "global_max_force", "global_max_torque", "guide_damping_linear", "guide_damping_angular",
     "guide_max_velocity_linear", "guide_max_velocity_angular", "compliant_default_velocity_linear",
     "move_away_velocity_linear", "normal_min_force", "normal_max_rate", "normal_jump", "normal_friction",
+    "spring_rounding",
 )
 
 

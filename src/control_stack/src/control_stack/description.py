@@ -45,6 +45,7 @@ ERD_PACKAGE = "example-robot-data"
 ERD_ENV = "EXAMPLE_ROBOT_DATA_DIR"
 _ERD_SUFFIX = os.path.join("cmeel.prefix", "share", ERD_PACKAGE)
 SHAPES = {"cylinder": 2, "box": 3, "sphere": 1}  # shape -> number of size values
+PLATE_THICKNESS = 0.01  # [m] ToolSpec.plate's
 
 
 class DescriptionError(StackError):
@@ -69,6 +70,9 @@ class ToolSpec:
         size: Shape dimensions [m]; the shape starts at the sensor face and extends along +Z.
         tip_name: Name of the massless frame link at the end of the shape (the tool centre point).
         rounded: A cylinder's end is a hemisphere of its radius (a ball-end polishing tool), same length.
+        plate: > 0: a square plate this wide [m], PLATE_THICKNESS thick, hangs centred below the shape's end,
+            its top face at the tip (a paddle held by its handle: mujoco_driver README, Cells). The mass,
+            centre of mass and inertia stay the shape's: the payload the stack knows does not change.
     """
 
     parent: str
@@ -83,6 +87,7 @@ class ToolSpec:
     size: tuple[float, ...] = field(default=(0.03, 0.1))
     tip_name: str = "tool_tip"
     rounded: bool = False
+    plate: float = 0.0
 
     def validate(self) -> None:
         """Check the numbers.
@@ -104,6 +109,8 @@ class ToolSpec:
             raise DescriptionError(f"tool inertia must be positive, got {self.inertia}")
         if self.rounded and (self.shape != "cylinder" or self.size[1] < self.size[0]):
             raise DescriptionError("a rounded end needs a cylinder at least as long as its radius")
+        if not 0.0 <= self.plate <= 1.0:
+            raise DescriptionError(f"tool plate width must be in [0, 1] m, got {self.plate}")
         names = {self.ft_name, self.name, self.tip_name}
         if len(names) != 3 or "" in names:
             raise DescriptionError("sensor, tool and tip link names must be distinct and non-empty")
@@ -299,6 +306,12 @@ def _tool_links(tool: ToolSpec) -> list[ET.Element]:
         elem = ET.SubElement(body, tag)
         ET.SubElement(elem, "origin", xyz=_fmt(tool.centre()), rpy="0 0 0")
         elem.append(_shape_geometry(tool))
+        if tool.plate > 0.0:
+            plate = ET.SubElement(body, tag)
+            ET.SubElement(plate, "origin", xyz=_fmt((0.0, 0.0, tool.length() + PLATE_THICKNESS / 2.0)),
+                          rpy="0 0 0")
+            ET.SubElement(ET.SubElement(plate, "geometry"), "box",
+                          size=_fmt((tool.plate, tool.plate, PLATE_THICKNESS)))
     tip = ET.Element("link", name=tool.tip_name)
     zero = (0.0, 0.0, 0.0)
     parent, sensor_name, tool_name, tip_name = tool.parent, tool.ft_name, tool.name, tool.tip_name
@@ -425,6 +438,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--tool-peg", type=float, default=0.0, metavar="WIDTH",
                         help="make the tool a square peg this wide [m], same length, mass and centre of mass "
                         "(contact_tasks' peg_in_hole; 0: the shape given)")
+    parser.add_argument("--tool-plate", type=float, default=0.0, metavar="WIDTH",
+                        help="a square plate this wide [m] hangs below the tool's end, its top face at the "
+                        "tip, same mass (a bimanual cell's holder; 0: none)")
     parser.add_argument("--tool-rounded", action="store_true",
                         help="end the cylinder tool in a hemisphere of its radius, same length, mass and "
                         "centre of mass (a ball-end polishing tool: curved parts)")
@@ -445,7 +461,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 com=tuple(args.tool_com) if args.tool_com else None,
                 inertia=tuple(args.tool_inertia) if args.tool_inertia else None,
                 shape=args.tool_shape, size=tuple(args.tool_size), tip_name=args.tip_name,
-                rounded=args.tool_rounded,
+                rounded=args.tool_rounded, plate=args.tool_plate,
             )
             if args.tool_peg > 0.0:
                 width, length = args.tool_peg, tool.length()

@@ -4,7 +4,8 @@ Each arm's parameters are where its own driver's would be (``/<arm>/mujoco_drive
 package's sim.launch with ``with_driver:=false``), its description at ``/<arm>/robot_description``, its tf
 prefix at ``/<arm>/tf_prefix``; the cell node's ``~arms`` lists the arms and their base poses in the world.
 The loop's settings (real-time factor, /clock) are the first arm's, its lockstep wait at most
-CELL_LOCKSTEP_WAIT; ``~viewer`` opens MuJoCo's window on the whole cell.
+CELL_LOCKSTEP_WAIT; ``~viewer`` opens MuJoCo's window on the whole cell. Each arm's tf tree hangs from
+``~world_frame`` (static transforms to its prefixed URDF root at its base pose): one tf tree for the cell.
 """
 
 from __future__ import annotations
@@ -14,7 +15,9 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 import rospy
+import tf2_ros
 from compliant_common.tf_prefix import TfPrefix
+from geometry_msgs.msg import TransformStamped
 
 from mujoco_driver.cell import CellArm, World
 from mujoco_driver.cell_file import triple
@@ -22,8 +25,9 @@ from mujoco_driver.config import ConfigError
 from mujoco_driver.node import ArmSetup, MujocoDriverNode, serve, watch_master
 from mujoco_driver.params import DriverParamError, DriverSettings, load_scene, urdf_root_link
 from mujoco_driver.ros_arm_port import PortNames
+from mujoco_driver.scene import rpy_to_quat
 
-__all__ = ["CellParamError", "main", "read_arms"]
+__all__ = ["CellParamError", "base_transforms", "main", "read_arms"]
 
 DRIVER_NAME = "mujoco_driver"  # each arm's driver node name, under its namespace
 # [s] wall time: the longest the world waits for one arm's silent stack (README, Lockstep). Every arm's time
@@ -78,8 +82,24 @@ def _arm(name: str, use_sim_time: bool) -> tuple[DriverSettings, str, TfPrefix]:
     return settings, rospy.get_param(key), TfPrefix(str(rospy.get_param(f"/{name}/tf_prefix", "")))
 
 
+Triple = tuple[float, float, float]
+
+
+def base_transforms(world_frame: str, roots: Sequence[tuple[str, Triple, Triple]]) -> list[TransformStamped]:
+    """Static transforms from `world_frame` to each (prefixed root frame, position [m], rpy [rad])."""
+    transforms = []
+    for frame, position, rpy in roots:
+        tf = TransformStamped()
+        tf.header.frame_id, tf.child_frame_id = world_frame, frame
+        tf.transform.translation.x, tf.transform.translation.y, tf.transform.translation.z = position
+        r = tf.transform.rotation
+        r.w, r.x, r.y, r.z = (float(v) for v in rpy_to_quat(rpy))
+        transforms.append(tf)
+    return transforms
+
+
 def build(arms: Sequence[tuple[str, tuple[float, float, float], tuple[float, float, float]]],
-          viewer: bool) -> MujocoDriverNode:
+          viewer: bool, roots: list | None = None) -> MujocoDriverNode:
     """The node serving `arms` in one world.
 
     Raises:
@@ -94,6 +114,8 @@ def build(arms: Sequence[tuple[str, tuple[float, float, float], tuple[float, flo
         except (DriverParamError, ConfigError) as exc:
             raise CellParamError(f"arm {name}: {exc}") from None
         found.append((name, settings, urdf, tf, scene, CellArm(name, urdf, scene, position, rpy)))
+        if roots is not None:
+            roots.append((tf.add(urdf_root_link(urdf)), position, rpy))
     world = World([f[-1] for f in found])
     setups = [ArmSetup(settings, world.arms[name], scene, settings.base_frame or urdf_root_link(urdf),
                        PortNames(f"/{name}/{DRIVER_NAME}", f"/{name}"), tf)
@@ -107,12 +129,17 @@ def build(arms: Sequence[tuple[str, tuple[float, float, float], tuple[float, flo
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``mujoco_cell`` executable."""
     arms: list = []
+    roots: list = []
+    kept = []  # the broadcaster lives as long as the node
 
     def make() -> MujocoDriverNode:
         arms.extend(read_arms(rospy.get_param("~arms", None)))
-        return build(arms, bool(rospy.get_param("~viewer", False)))
+        return build(arms, bool(rospy.get_param("~viewer", False)), roots)
 
     def started(_node: MujocoDriverNode) -> None:
+        broadcaster = tf2_ros.StaticTransformBroadcaster()
+        broadcaster.sendTransform(base_transforms(str(rospy.get_param("~world_frame", "world")), roots))
+        kept.append(broadcaster)
         # A restarted roscore gets every arm's driver parameters and description back, as from its own driver.
         watch_master(["~", "/use_sim_time", *(f"/{name}/{key}" for name, _, _ in arms
                                               for key in (DRIVER_NAME, "robot_description"))])

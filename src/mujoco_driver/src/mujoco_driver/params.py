@@ -78,8 +78,9 @@ class DriverSettings:
         0.01, unit="s", ge=0.0, doc="period of `~eef_pose` (ground truth for plots); 0 = with `joint_states`"
     )
     fixture: str = param(
-        "none", choices=("none", "hole", "hand", "tilted", "cylinder", "sphere"),
-        doc="hole: a plate with a square, chamfered hole on the obstacle block, for a square peg tool; hand: "
+        "none", choices=("none", "clear", "hole", "hand", "tilted", "cylinder", "sphere"),
+        doc="clear: no block (a cell's arms meeting over the tables); hole: a plate with a square, chamfered "
+        "hole on the obstacle block, for a square peg tool; hand: "
         "a person's hand (ISO/TS 15066: 0.6 kg, 75 N/mm) lying on the block; tilted: the block turned by "
         "`surface_tilt` about the base's y axis, a sloping top; cylinder (axis along y), sphere: a curved "
         "part in the block's place, its top at the block's top centre (README, Fixtures)",
@@ -304,6 +305,8 @@ def load_scene(settings: DriverSettings) -> SceneConfig:
         cfg = dataclasses.replace(cfg, hole=hole)
     if settings.fixture in SURFACE_RADIUS:
         cfg = _with_surface(cfg, settings)
+    if settings.fixture == "clear":
+        cfg = dataclasses.replace(cfg, obstacle=None)
     if settings.fixture == "hand":
         if cfg.obstacle is None:
             raise DriverParamError("~fixture hand: the scene has no obstacle block to lay the hand on")

@@ -13,7 +13,7 @@ import numpy as np
 from thesis_demos.scenarios import SURFACE_SETTLE, SURFACE_TOLERANCE, TEACH_PATH_MAX, TEACH_PATH_RMS, Scenario
 
 __all__ = ["CONTACT_FORCE_BOUND", "RESIDUAL_WINDOW", "SURFACE_AVERAGING", "Recording", "Replayed", "Verdict",
-           "judge"]
+           "judge", "moving_mean"]
 
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 # Compliant move stops on contact without pressing harder than this [N]. Why: the arm is a stiff
@@ -230,7 +230,7 @@ def _hybrid(scenario: Scenario, rec: Recording) -> Verdict:
     return Verdict(passed, summary, figures)
 
 
-def _moving_mean(t: np.ndarray, y: np.ndarray, span: float) -> np.ndarray:
+def moving_mean(t: np.ndarray, y: np.ndarray, span: float) -> np.ndarray:
     """Means of `y` over consecutive windows of `span` seconds (sliding by one sample)."""
     if len(t) < 2:
         return y.copy()
@@ -302,7 +302,7 @@ def _pressed_force(rec: Recording, start: float, end: float) -> tuple[float, flo
     if not force.size:
         nan = float("nan")
         return nan, nan, nan, nan, nan
-    smooth = _moving_mean(rec.wrench_t[win], force, SURFACE_AVERAGING)
+    smooth = moving_mean(rec.wrench_t[win], force, SURFACE_AVERAGING)
     return (float(np.mean(force)), float(np.std(force)), float(np.std(smooth)), float(np.min(smooth)),
             float(np.max(smooth)))
 

@@ -9,6 +9,7 @@ orientation.
 
 from __future__ import annotations
 
+import dataclasses
 import threading
 import time
 from dataclasses import dataclass
@@ -18,6 +19,7 @@ import rospy
 import tf2_ros
 from cartesian_impedance_msgs.srv import ConfigureForceControl
 from compliant_common.ros_tf_prefix import for_this_node
+from compliant_common.tf_prefix import TfPrefix
 from compliant_control_msgs.msg import ContactControlStatus, ContactEvent
 from compliant_control_msgs.srv import (
     ConfigureLaws,
@@ -26,6 +28,7 @@ from compliant_control_msgs.srv import (
     PushEEFRequest,
     PushEEFResponse,
 )
+from contact_control.frames import quaternion_matrix
 from contact_control.noise_floor import NoiseFloor
 from contact_control.params import ContactControlSettings
 from geometry_msgs.msg import PoseStamped, WrenchStamped
@@ -51,6 +54,12 @@ class Names:
     wrench: str = "wrench"
     base_frame: str = ""  # empty: contact_control's ~fixed_frame
 
+    def within(self, ns: str) -> Names:
+        """These names under the namespace `ns` (another robot's: a cell's arm)."""
+        head = "/" + ns.strip("/") + "/"
+        return dataclasses.replace(self, **{f.name: head + getattr(self, f.name).lstrip("/")
+                                            for f in dataclasses.fields(self)
+                                            if f.name != "base_frame" and getattr(self, f.name)})
 
 
 class Series:
@@ -84,7 +93,8 @@ class StackClient:
     """The stack's ROS interface for the demonstrations, connected once: laws sent, pushes, the move's state,
     the tool's pose and the forces recorded as series."""
 
-    def __init__(self, names: Names, timeout: float = 60.0) -> None:
+    def __init__(self, names: Names, timeout: float = 60.0, tf_prefix: TfPrefix | None = None) -> None:
+        """`tf_prefix`: the robot's tf prefix (default: the one nearest this node's namespace)."""
         self.names = names
         cc, drv = names.contact_control, names.driver
         for service in (
@@ -99,7 +109,7 @@ class StackClient:
             rospy.wait_for_service(service, timeout=timeout)
         self._configure = rospy.ServiceProxy(names.configure, ConfigureForceControl)
         self._configure_laws = rospy.ServiceProxy(names.configure_laws, ConfigureLaws)
-        self._tare = rospy.ServiceProxy(f"{cc}/tare", Trigger)
+        self._tare_service = rospy.ServiceProxy(f"{cc}/tare", Trigger)
         self._stop_service = rospy.ServiceProxy(f"{cc}/stop", Trigger)
         self._reset_safety = rospy.ServiceProxy(f"{cc}/reset", Trigger)
         self._push_service = rospy.ServiceProxy(f"{drv}/push", PushEEF)
@@ -116,7 +126,7 @@ class StackClient:
         )
         self._tf = tf2_ros.Buffer()
         self._tf_listener = tf2_ros.TransformListener(self._tf)
-        self._tf_prefix = for_this_node()  # the robot's frames on tf
+        self._tf_prefix = tf_prefix if tf_prefix is not None else for_this_node()  # the robot's frames on tf
         self.pose = Series(3)
         self._status = Series(6)
         self._wrench = Series(3)
@@ -192,7 +202,7 @@ class StackClient:
             ]
         ) @ np.diag(signs)
 
-    def _settle(self, timeout: float = 10.0, window: float = 0.3, tolerance: float = 2e-4) -> None:
+    def settle(self, timeout: float = 10.0, window: float = 0.3, tolerance: float = 2e-4) -> None:
         """Waits until the tool has moved less than `tolerance` over `window` seconds."""
 
         self.pose.clear()
@@ -224,7 +234,7 @@ class StackClient:
         """Named pose `start` (a joint-space move, as on a real arm), else the driver's reset; then still."""
         self.stop()
         if self._move_to is not None:
-            self._settle()  # the stop's last zero commands are through before the trajectory goes out
+            self.settle()  # the stop's last zero commands are through before the trajectory goes out
             result = self._move_to(name="start", speed_scale=1.0)
             if not result.success:
                 raise RuntimeError(f"named pose 'start' failed: {result.message}")
@@ -232,7 +242,7 @@ class StackClient:
             result = self._reset_sim()
             if not result.success:
                 raise RuntimeError(f"driver reset failed: {result.message}")
-        self._settle()
+        self.settle()
 
     # --- one scenario ---
     def prepare(self, sensor_frame: str) -> float:
@@ -241,9 +251,7 @@ class StackClient:
         few ms of the configure call alone could leave a loaded machine without a wrench)."""
         self._to_start()
         self._reset_safety()
-        tare = self._tare()
-        if not tare.success:
-            raise RuntimeError(f"tare failed: {tare.message}")
+        self.tare()
         self._update_sensor_rotation(sensor_frame)
         for series in (self.pose, self._status, self._wrench):
             series.clear()
@@ -261,6 +269,63 @@ class StackClient:
         response = self._configure(build_request(scenario))
         if not response.success:
             raise RuntimeError(f"{scenario.name}: contact_control refused the request (see its ~status)")
+
+    def tare(self) -> None:
+        """contact_control's `~tare`: the sensor's offset measured where the arm is now.
+
+        Raises:
+            RuntimeError: With the node's reason, if it refused.
+        """
+        tare = self._tare_service()
+        if not tare.success:
+            raise RuntimeError(f"tare failed: {tare.message}")
+
+    def send_laws(self, laws: dict[str, AxisLaw], exceeded_action: str = "stop") -> int:
+        """Laws per axis through configure_laws (axes left out hold); returns how many moves had ended
+        before (:meth:`wait_move_end`'s `before`).
+
+        Raises:
+            RuntimeError: With contact_control's reason, if it refused them.
+        """
+        with self._status_lock:
+            before = len(self._move_ends)
+        answer = self._configure_laws(build_laws_request(laws, exceeded_action))
+        if not answer.success:
+            raise RuntimeError(f"contact_control refused the laws: {answer.message}")
+        return before
+
+    def wait_move_end(self, before: int, timeout: float, what: str) -> None:
+        """Waits for contact_control's move_ended event of the move sent after `before` had ended."""
+
+        def ended() -> bool:
+            with self._status_lock:
+                return len(self._move_ends) > before
+
+        self.wait(ended, timeout, what)
+
+    def _lookup(self, target: str, source: str):
+        """tf's transform from `source` to `target`, both full tf names."""
+        return self._tf.lookup_transform(target, source, rospy.Time(0), rospy.Duration(5.0))
+
+    def world_pose(self, frame: str) -> tuple[np.ndarray, tuple[float, float, float, float]]:
+        """The tool tip's (contact_control's `eef_frame`) position [m] and orientation (x, y, z, w) in the tf
+        frame `frame`, taken as it is (a cell's `world`, above every arm's tf prefix)."""
+        key = f"{self.names.contact_control}/eef_frame"
+        eef = str(rospy.get_param(key, ContactControlSettings.eef_frame))
+        tf = self._lookup(frame, self._tf_prefix.add(eef)).transform
+        t, q = tf.translation, tf.rotation
+        return np.array([t.x, t.y, t.z]), (q.x, q.y, q.z, q.w)
+
+    def tool_pose(self) -> tuple[np.ndarray, tuple[float, float, float, float]]:
+        """The tool tip's pose in contact_control's fixed frame (where its laws' travel is measured)."""
+        return self.world_pose(self._tf_prefix.add(self._base_frame))
+
+    def in_base(self, frame: str, point: np.ndarray) -> np.ndarray:
+        """`point` [m], given in the tf frame `frame` (taken as it is), in contact_control's fixed frame."""
+        tf = self._lookup(self._tf_prefix.add(self._base_frame), frame).transform
+        t, q = tf.translation, tf.rotation
+        R = np.asarray(quaternion_matrix(q.x, q.y, q.z, q.w))
+        return R @ np.asarray(point, dtype=float) + np.array([t.x, t.y, t.z])
 
     def push(self, request: PushEEFRequest) -> PushEEFResponse:
         """The driver's `~push` (a simulated hand on the tool)."""

@@ -30,13 +30,13 @@ def sim_launch(plan: Plan) -> str:
   <arg name="single_process" default="true" doc="contact_control and jog_arm in one process (control_stack_node), one hop less"/>
   <arg name="with_driver" default="true" doc="false: no driver of its own, only its parameters (a cell's one world simulates this robot: mujoco_driver README, Cells)"/>
   <arg name="publish_synchronously" default="true" doc="the driver writes subscribers' sockets in its loop"/>
-  <arg name="fixture" default="none" doc="hole: a plate with a square, chamfered hole on the block; hand: a person's hand (ISO/TS 15066) lying on it; tilted: the block's top tilted 15 degrees; cylinder, sphere: a curved part in the block's place (mujoco_driver README, Fixtures)"/>
+  <arg name="fixture" default="none" doc="clear: no block; hole: a plate with a square, chamfered hole on the block; hand: a person's hand (ISO/TS 15066) lying on it; tilted: the block's top tilted 15 degrees; cylinder, sphere: a curved part in the block's place (mujoco_driver README, Fixtures)"/>
   <arg name="hole_offset" default="[0.0, 0.0, 0.0]" doc="the hole's offset from its nominal pose '[dx, dy, yaw]' [m, m, rad]"/>
   <arg name="hole_seed" default="-1" doc="&gt;= 0: the hole's offset drawn from this seed instead (within 4 mm and 2 degrees)"/>
   <arg name="surface_seed" default="-1" doc="&gt;= 0: the tilted, cylinder or sphere fixture's offset drawn from this seed (each of dx, dy, dz within 10 mm)"/>
   <arg name="surface_offset" default="[0.0, 0.0, 0.0]" doc="the tilted, cylinder or sphere fixture's offset from its nominal place '[dx, dy, dz]' [m]"/>
   <arg name="hole_clearance" default="0.0004" doc="[m] the hole's width minus the peg's"/>
-  <arg name="tool" default="default" doc="peg: the tool becomes a 10 mm square peg of the same length and mass; ball: its end a hemisphere (curved parts)"/>
+  <arg name="tool" default="default" doc="peg: the tool becomes a 10 mm square peg of the same length and mass; ball: its end a hemisphere (curved parts); plate: a 0.5 m square plate hangs below its end (a cell's bimanual holder)"/>
   <arg name="output" default="screen" doc="screen or log"/>
 
   <include file="$(find mujoco_driver)/launch/sim_stack.launch">
