@@ -159,3 +159,21 @@ def test_a_demo_the_arm_cannot_do_is_named_with_the_reason(ur3_copy):
     assert list(per_demo) == ["hybrid"]
     expected = "the tool-tip motion (-0.620, +0.000, +0.000) m is not reachable from the start pose"
     assert expected in per_demo["hybrid"][0]
+
+
+def test_checker_names_the_joint_whose_servo_cannot_hold_the_start_pose(ur3_copy, tmp_path):
+    """The URDF's wrist efforts weakened to 0.2 Nm: the kinematic checks pass, but in the simulation the
+    tool's weight bends a wrist joint down (make demo would stop at its first named pose); the checker says
+    which joint and why."""
+    from control_stack.description import find_example_robot_data
+
+    stock = pathlib.Path(find_example_robot_data()) / "robots/ur_description/urdf/ur3_robot.urdf"
+    text = stock.read_text()
+    assert text.count('effort="54.0"') == 3  # wrist 1-3
+    weak = tmp_path / "weak_ur3.urdf"
+    weak.write_text(text.replace('effort="54.0"', 'effort="0.2"'))
+    stock_source = "example-robot-data:robots/ur_description/urdf/ur3_robot.urdf"
+    _edit(ur3_copy / "config/description.args", stock_source, str(weak))
+    (problem,) = check_package(str(ur3_copy))
+    assert problem.startswith("named pose 'start': the simulated arm ends"), problem
+    assert "at wrist_" in problem and "effort limit, 0.2 Nm" in problem

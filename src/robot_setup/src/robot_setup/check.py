@@ -39,6 +39,7 @@ from control_stack.description import (
 )
 from jog_arm.kinematics import ArmModel, KinematicsError
 from jog_arm.settings import JogSettings, SettingsError, held_positions
+from named_poses.params import NamedPoseSettings
 from thesis_demos.geometry import (
     DemoConfigError,
     demo_motions,
@@ -50,6 +51,7 @@ from thesis_demos.geometry import (
 
 from robot_setup.analysis import LENGTH_SCALE, MIN_JOINT_HEIGHT, MIN_MARGIN, analyse_pose, lowest_joint
 from robot_setup.collisions import CollisionChecker
+from robot_setup.hold_check import hold_problems
 
 __all__ = [
     "DEMOS",
@@ -245,14 +247,25 @@ def check_package(root: str) -> list[str]:
         f"{report.min_margin:.2f} rad"
     )
     poses_path = os.path.join(cfg, "named_poses.yaml")
+    poses: dict = {}
     if os.path.isfile(poses_path):
-        named_start = (_yaml(poses_path).get("poses") or {}).get("start")
+        named_file = _yaml(poses_path)
+        poses = named_file.get("poses") or {}
+        named_start = poses.get("start")
         if named_start is None:
             problems.append("named_poses.yaml: no pose 'start' (the demos move there)")
         elif any(abs(float(named_start.get(j, math.nan)) - float(start[j])) > 1e-9 for j in arm.joint_names):
             problems.append("named_poses.yaml: poses.start differs from sim.yaml's start_pose")
+        tolerance = float(named_file.get("goal_tolerance", NamedPoseSettings.goal_tolerance))
     else:
         problems.append("config/named_poses.yaml: missing (named poses, the demos' start)")
+        tolerance = NamedPoseSettings.goal_tolerance
+    if not problems:  # the simulated arm, held there and moved through its named poses (hold_check)
+        try:
+            problems += hold_problems(urdf, scene, {k: v for k, v in poses.items() if k != "start"},
+                                      tolerance)
+        except StackError as exc:
+            problems.append(f"sim.yaml: the simulated scene cannot be built: {exc}")
     return problems
 
 
@@ -282,7 +295,8 @@ def print_report(root: str, problems: Sequence[str]) -> None:
         for p in problems:
             print(f"[check]   - {p}")
     else:
-        print(f"[check] {os.path.basename(root)}: OK (frames, tool, start pose, demos' reach)")
+        print(f"[check] {os.path.basename(root)}: OK (frames, tool, start pose, demos' reach, named poses "
+              "held in simulation)")
 
 
 def main(argv: Sequence[str] | None = None) -> int:
