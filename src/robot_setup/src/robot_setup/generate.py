@@ -22,6 +22,7 @@ Reproducible: fixed grids and seeds, rounded numbers, no dates; the same command
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import os
 import sys
@@ -217,12 +218,39 @@ def _demos(scale: float) -> tuple[float, DemoGeometry]:
     )
 
 
+def fixed_end(urdf_xml: str, tip: str) -> str:
+    """The deepest link fixed to `tip` through fixed joints alone, one child at each step ("" if none): where
+    a flange's own adapter (a gripper's stator, a tool plate) puts a tool further out along the wrist."""
+    _, children = _tree(urdf_xml)
+    link = tip
+    while len(children.get(link, [])) == 1 and children[link][0][1] == "fixed":
+        link = children[link][0][0]
+    return "" if link == tip else link
+
+
 def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
-    """Measure the arm and decide every number of its package (see the module docstring).
+    """Measure the arm and decide every number of its package (see the module docstring). When no mounting on
+    TIP has a start pose and the user gave none (TOOL_RPY), the link fixed below TIP is tried as the flange
+    (the Unitree Z1's link06 -> gripperStator: a tool across link06 touches link04 in every posture).
 
     Raises:
         GeneratorError: Bad input, or no usable start pose (why, in words).
     """
+    try:
+        return _plan_robot(spec, log)
+    except NoMountingError as exc:
+        deeper = fixed_end(_source(spec.urdf)[1], spec.tip) if spec.tool_rpy is None else ""
+        if not deeper:
+            raise
+        log(f"[robot] no mounting on {spec.tip} ({exc}); trying {deeper}, fixed below it, as the flange "
+            f"(TIP={deeper})")
+        try:
+            return _plan_robot(dataclasses.replace(spec, tip=deeper), log)
+        except NoMountingError:
+            raise exc from None
+
+
+def _plan_robot(spec: RobotSpec, log: Callable[[str], object]) -> Plan:
     name = spec.name
     if not name or not name.replace("_", "").isalnum() or not name[0].isalpha() or name != name.lower():
         raise GeneratorError(f"NAME={spec.name!r}: use lower-case letters, digits and _ (a ROS package name)")
@@ -282,7 +310,7 @@ def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
             smaller = scale * SCALE_STEP
             if exc.hopeless or smaller < MIN_SCALE:
                 if scale < min(1.0, reach / REFERENCE_REACH):
-                    raise GeneratorError(f"{exc} (demos scaled down to {scale:.2f})") from exc
+                    raise NoMountingError(f"{exc} (demos scaled down to {scale:.2f})", exc.hopeless) from exc
                 raise
             log(f"[robot] no start pose for the demos at this scale: trying them smaller (a tool-down "
                 f"workspace smaller than the reach: {exc})")
