@@ -29,8 +29,22 @@ def _worst(sim: Simulation, goal: np.ndarray) -> tuple[int, float]:
     return i, float(error[i])
 
 
+def _touching(sim: Simulation) -> list[str]:
+    """The pairs of bodies in contact now (the arm pushed off its pose by a part of the robot, the table)."""
+    model, data = sim.scene.model, sim.data
+    pairs = {tuple(sorted((model.body(model.geom_bodyid[c.geom1]).name or "world",
+                           model.body(model.geom_bodyid[c.geom2]).name or "world")))
+             for c in data.contact[:data.ncon]}
+    return [f"{a} / {b}" for a, b in sorted(pairs)]
+
+
 def _why(sim: Simulation, i: int, kp: float) -> str:
-    """The servo's side of a joint that did not get there: its torque against the URDF's effort."""
+    """Why a joint did not get there: a contact pushing the arm, or its servo's torque against the URDF's
+    effort."""
+    touching = _touching(sim)
+    if touching:
+        return f"the simulated arm touches {', '.join(touching)} there (the scene collides what the start " \
+               "pose search let touch)"
     model = sim.scene.model
     joint = model.joint(sim.joint_names[i]).id  # MuJoCo's URDF reader limits its actuator force to the effort
     limit = float(model.jnt_actfrcrange[joint][1]) if model.jnt_actfrclimited[joint] else np.inf
