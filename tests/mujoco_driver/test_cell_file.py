@@ -96,6 +96,7 @@ def test_the_cell_node_hangs_each_arms_tf_tree_from_the_world_at_its_base_pose()
     t, q = right.transform.translation, right.transform.rotation
     assert (right.child_frame_id, (t.x, t.y, t.z)) == ("right/panda_link0", (0.0, 0.8, 0.1))
     assert (q.x, q.y, q.z, q.w) == pytest.approx((0.0, 0.0, math.sin(math.pi / 4), math.cos(math.pi / 4)))
+    assert base_transforms("world", [("world", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))]) == []  # no loop
 
 
 def test_apart_each_arm_runs_its_own_simulation_and_no_cell_node():

@@ -86,9 +86,12 @@ Triple = tuple[float, float, float]
 
 
 def base_transforms(world_frame: str, roots: Sequence[tuple[str, Triple, Triple]]) -> list[TransformStamped]:
-    """Static transforms from `world_frame` to each (prefixed root frame, position [m], rpy [rad])."""
+    """Static transforms from `world_frame` to each (prefixed root frame, position [m], rpy [rad]); a root
+    that is `world_frame` itself (an arm without a tf prefix whose URDF root is `world`) has none."""
     transforms = []
     for frame, position, rpy in roots:
+        if frame == world_frame:
+            continue
         tf = TransformStamped()
         tf.header.frame_id, tf.child_frame_id = world_frame, frame
         tf.transform.translation.x, tf.transform.translation.y, tf.transform.translation.z = position
