@@ -93,15 +93,16 @@ def test_make_robot_options_are_read_and_recorded_as_given(capsys):
         assert err.count("\n") == 1 and err.startswith("make robot: error: "), err
 
 
-def test_an_arm_with_no_tool_down_pose_straight_or_on_any_adapter_is_refused_in_one_line(capsys):
-    """TIAGo's tool on the wrist's centre collides with the wrist whatever the adapter: `make robot` says so
-    in one line, naming TOOL_RPY, and writes nothing."""
-    code = main(["--name", "t", "--urdf", TIAGO, "--tip", "arm_7_link", "--base", "torso_lift_link",
-                 "--src", "/nonexistent"])
-    out, err = capsys.readouterr()
-    assert code == 2 and err.count("\n") == 1, err
-    assert "nor with the sensor on an adapter at 45 or 90 degrees" in err and "TOOL_RPY=" in err
-    assert out.count("[robot]   adapter") == 8
+def test_a_wrist_no_mounting_fits_takes_the_flange_fixed_below_it():
+    """TIAGo's tool on its wrist's centre (arm_7_link) collides with the wrist whatever the adapter; make
+    robot says so and takes arm_tool_link, fixed below it, as the flange (the one its README names)."""
+    said: list[str] = []
+    plan = plan_robot(RobotSpec("t", TIAGO, "arm_7_link", base="torso_lift_link"), log=said.append)
+    assert sum("[robot]   adapter" in line for line in said) >= 8  # arm_7_link: straight and every adapter
+    (fallback,) = [line for line in said if line.startswith("[robot] no mounting on arm_7_link")]
+    assert "nor with the sensor on an adapter at 45 or 90 degrees" in fallback
+    assert "trying arm_tool_link, fixed below it" in fallback
+    assert plan.spec.tip == "arm_tool_link"
 
 
 def test_a_file_that_is_not_a_urdf_is_refused_in_one_line(tmp_path, capsys):

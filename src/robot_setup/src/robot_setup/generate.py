@@ -218,20 +218,22 @@ def _demos(scale: float) -> tuple[float, DemoGeometry]:
     )
 
 
-def fixed_end(urdf_xml: str, tip: str) -> str:
-    """The deepest link fixed to `tip` through fixed joints alone, one child at each step ("" if none): where
-    a flange's own adapter (a gripper's stator, a tool plate) puts a tool further out along the wrist."""
+def fixed_below(urdf_xml: str, tip: str) -> list[str]:
+    """The links fixed below `tip` through fixed joints alone, one child at each step, nearest first: where a
+    flange's own adapter (a gripper's stator, a tool flange, a wrist sensor) puts a tool further out."""
     _, children = _tree(urdf_xml)
-    link = tip
+    links, link = [], tip
     while len(children.get(link, [])) == 1 and children[link][0][1] == "fixed":
         link = children[link][0][0]
-    return "" if link == tip else link
+        links.append(link)
+    return links
 
 
 def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
     """Measure the arm and decide every number of its package (see the module docstring). When no mounting on
-    TIP has a start pose and the user gave none (TOOL_RPY), the link fixed below TIP is tried as the flange
-    (the Unitree Z1's link06 -> gripperStator: a tool across link06 touches link04 in every posture).
+    TIP has a start pose and the user gave none (TOOL_RPY), the links fixed below TIP are tried as the flange,
+    nearest first (the Unitree Z1's link06 -> gripperStator: a tool across link06 touches link04 in every
+    posture; TIAGo's arm_7_link -> arm_tool_link).
 
     Raises:
         GeneratorError: Bad input, or no usable start pose (why, in words).
@@ -239,15 +241,17 @@ def plan_robot(spec: RobotSpec, log: Callable[[str], object] = print) -> Plan:
     try:
         return _plan_robot(spec, log)
     except NoMountingError as exc:
-        deeper = fixed_end(_source(spec.urdf)[1], spec.tip) if spec.tool_rpy is None else ""
-        if not deeper:
+        below = fixed_below(_source(spec.urdf)[1], spec.tip) if spec.tool_rpy is None else []
+        if not below:
             raise
-        log(f"[robot] no mounting on {spec.tip} ({exc}); trying {deeper}, fixed below it, as the flange "
-            f"(TIP={deeper})")
-        try:
-            return _plan_robot(dataclasses.replace(spec, tip=deeper), log)
-        except NoMountingError:
-            raise exc from None
+        for deeper in below:
+            log(f"[robot] no mounting on {spec.tip} ({exc}); trying {deeper}, fixed below it, as the flange "
+                f"(TIP={deeper})")
+            try:
+                return _plan_robot(dataclasses.replace(spec, tip=deeper), log)
+            except NoMountingError:
+                continue
+        raise exc from None
 
 
 def _plan_robot(spec: RobotSpec, log: Callable[[str], object]) -> Plan:
