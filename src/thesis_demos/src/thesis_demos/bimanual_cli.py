@@ -2,8 +2,9 @@
 Bimanual).
 
 The cell must run with the demonstration's scene (thesis_demos.bimanual.scene_args; `make demo CELL=` does
-it). Prints the verdict lines, writes bimanual.png and report.md into `--output`; exit 0 when it passed, 1
-when it failed, 2 when it could not run (a cell file without `bimanual`, no stack).
+it). Prints the verdict lines, writes bimanual.png, report.md and the recorded series (bimanual.npz) into
+`--output`; exit 0 when it passed, 1 when it failed or a stack did not answer, 2 for a cell file that cannot
+be read or has no `bimanual`.
 """
 
 from __future__ import annotations
