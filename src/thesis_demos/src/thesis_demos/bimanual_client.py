@@ -79,6 +79,10 @@ class BimanualFlow:
     def _run(self, client: actionlib.SimpleActionClient, spec: Bimanual, sensor_frame: str,
              timeout: float) -> BimanualRecording:
         holder, presser = self._holder, self._presser
+        # A cell just launched: each arm's tf may come seconds after its topics.
+        for stack in (holder, presser):
+            stack.wait(lambda s=stack: s.sees(self._world, sensor_frame), timeout,
+                       f"tf from {self._world} to {stack.names.contact_control}'s tool and sensor")
         presser.start_tip()
         holder.prepare(sensor_frame)
         target = holder.in_base(self._world, np.asarray(spec.plate, dtype=float))

@@ -316,6 +316,15 @@ class StackClient:
         t, q = tf.translation, tf.rotation
         return np.array([t.x, t.y, t.z]), (q.x, q.y, q.z, q.w)
 
+    def sees(self, frame: str, sensor_frame: str) -> bool:
+        """Whether tf has this robot's tool tip in the tf frame `frame` (taken as it is) and its sensor in
+        contact_control's fixed frame: its robot_state_publisher is up and its frames hang from `frame`."""
+        key = f"{self.names.contact_control}/eef_frame"
+        eef = self._tf_prefix.add(str(rospy.get_param(key, ContactControlSettings.eef_frame)))
+        base = self._tf_prefix.add(self._base_frame)
+        return bool(self._tf.can_transform(frame, eef, rospy.Time(0))
+                    and self._tf.can_transform(base, self._tf_prefix.add(sensor_frame), rospy.Time(0)))
+
     def tool_pose(self) -> tuple[np.ndarray, tuple[float, float, float, float]]:
         """The tool tip's pose in contact_control's fixed frame (where its laws' travel is measured)."""
         return self.world_pose(self._tf_prefix.add(self._base_frame))
