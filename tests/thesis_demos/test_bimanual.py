@@ -45,6 +45,7 @@ def test_names_within_a_namespace_are_absolute_and_keep_an_empty_base_frame():
     names = Names().within("/right/")
     assert names.configure_laws == "/right/configure_laws"
     assert names.contact_control == "/right/contact_control_node" and names.base_frame == ""
+    assert names.tf_prefix == "/right/tf_prefix"  # read where that arm's launch set it, not nearest this node
 
 
 def _recording(**changes) -> BimanualRecording:

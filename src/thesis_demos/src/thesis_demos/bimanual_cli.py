@@ -71,7 +71,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"[bimanual] {args.cell} has no `bimanual`: where its arms meet", file=sys.stderr)
         return 2
     import rospy
-    from compliant_common.tf_prefix import TfPrefix
 
     from thesis_demos.bimanual import judge
     from thesis_demos.bimanual_client import BimanualFlow
@@ -81,8 +80,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     started = time.monotonic()
 
     def stack(ns: str) -> StackClient:
-        prefix = TfPrefix(str(rospy.get_param(f"/{ns}/tf_prefix", "")))
-        return StackClient(Names().within(ns), args.timeout, prefix)
+        return StackClient(Names().within(ns), args.timeout)
 
     try:
         holder, presser = stack(spec.holder), stack(spec.presser)

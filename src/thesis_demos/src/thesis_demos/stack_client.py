@@ -53,6 +53,7 @@ class Names:
     teach: str = "teach"  # teach's program_server (teach and replay)
     wrench: str = "wrench"
     base_frame: str = ""  # empty: contact_control's ~fixed_frame
+    tf_prefix: str = "tf_prefix"  # the parameter with the robot's tf prefix; relative: the nearest one up
 
     def within(self, ns: str) -> Names:
         """These names under the namespace `ns` (another robot's: a cell's arm)."""
@@ -93,8 +94,7 @@ class StackClient:
     """The stack's ROS interface for the demonstrations, connected once: laws sent, pushes, the move's state,
     the tool's pose and the forces recorded as series."""
 
-    def __init__(self, names: Names, timeout: float = 60.0, tf_prefix: TfPrefix | None = None) -> None:
-        """`tf_prefix`: the robot's tf prefix (default: the one nearest this node's namespace)."""
+    def __init__(self, names: Names, timeout: float = 60.0) -> None:
         self.names = names
         cc, drv = names.contact_control, names.driver
         for service in (
@@ -126,7 +126,10 @@ class StackClient:
         )
         self._tf = tf2_ros.Buffer()
         self._tf_listener = tf2_ros.TransformListener(self._tf)
-        self._tf_prefix = tf_prefix if tf_prefix is not None else for_this_node()  # the robot's frames on tf
+        # Read once the services are up: a launch sets every parameter before it starts a node.
+        absolute = names.tf_prefix.startswith("/")
+        self._tf_prefix = (TfPrefix(str(rospy.get_param(names.tf_prefix, ""))) if absolute
+                           else for_this_node())  # the robot's frames on tf
         self.pose = Series(3)
         self._status = Series(6)
         self._wrench = Series(3)
@@ -185,11 +188,7 @@ class StackClient:
             time.sleep(0.01)
 
     def _update_sensor_rotation(self, sensor_frame: str) -> None:
-        prefix = self._tf_prefix
-        tf = self._tf.lookup_transform(
-            prefix.add(self._base_frame), prefix.add(sensor_frame), rospy.Time(0), rospy.Duration(5.0)
-        )
-        q = tf.transform.rotation
+        q = self._lookup(self._base(), self._tf_prefix.add(sensor_frame)).transform.rotation
         x, y, z, w = q.x, q.y, q.z, q.w
         # The wrench is read as contact_control reads it: its ft_*_direction sign flips first (a driver that
         # reports the wrench the robot exerts has all three -1 in its robot package's hardware YAML).
@@ -262,9 +261,10 @@ class StackClient:
     def send(self, scenario: Scenario, laws: dict[str, AxisLaw]) -> None:
         """Sends laws through configure_laws when the scenario needs it, else the original service."""
         if scenario.uses_laws_service:
-            answer = self._configure_laws(build_laws_request(laws, scenario.exceeded_action))
-            if not answer.success:
-                raise RuntimeError(f"{scenario.name}: contact_control refused the laws: {answer.message}")
+            try:
+                self.send_laws(laws, scenario.exceeded_action)
+            except RuntimeError as exc:
+                raise RuntimeError(f"{scenario.name}: {exc}") from None
             return
         response = self._configure(build_request(scenario))
         if not response.success:
@@ -307,31 +307,36 @@ class StackClient:
         """tf's transform from `source` to `target`, both full tf names."""
         return self._tf.lookup_transform(target, source, rospy.Time(0), rospy.Duration(5.0))
 
+    def _eef(self) -> str:
+        """The tool tip's full tf name (contact_control's `eef_frame`)."""
+        key = f"{self.names.contact_control}/eef_frame"
+        return self._tf_prefix.add(str(rospy.get_param(key, ContactControlSettings.eef_frame)))
+
+    def _base(self) -> str:
+        """contact_control's fixed frame's full tf name."""
+        return self._tf_prefix.add(self._base_frame)
+
     def world_pose(self, frame: str) -> tuple[np.ndarray, tuple[float, float, float, float]]:
         """The tool tip's (contact_control's `eef_frame`) position [m] and orientation (x, y, z, w) in the tf
         frame `frame`, taken as it is (a cell's `world`, above every arm's tf prefix)."""
-        key = f"{self.names.contact_control}/eef_frame"
-        eef = str(rospy.get_param(key, ContactControlSettings.eef_frame))
-        tf = self._lookup(frame, self._tf_prefix.add(eef)).transform
+        tf = self._lookup(frame, self._eef()).transform
         t, q = tf.translation, tf.rotation
         return np.array([t.x, t.y, t.z]), (q.x, q.y, q.z, q.w)
 
     def sees(self, frame: str, sensor_frame: str) -> bool:
         """Whether tf has this robot's tool tip in the tf frame `frame` (taken as it is) and its sensor in
         contact_control's fixed frame: its robot_state_publisher is up and its frames hang from `frame`."""
-        key = f"{self.names.contact_control}/eef_frame"
-        eef = self._tf_prefix.add(str(rospy.get_param(key, ContactControlSettings.eef_frame)))
-        base = self._tf_prefix.add(self._base_frame)
-        return bool(self._tf.can_transform(frame, eef, rospy.Time(0))
-                    and self._tf.can_transform(base, self._tf_prefix.add(sensor_frame), rospy.Time(0)))
+        sensor = self._tf_prefix.add(sensor_frame)
+        return bool(self._tf.can_transform(frame, self._eef(), rospy.Time(0))
+                    and self._tf.can_transform(self._base(), sensor, rospy.Time(0)))
 
     def tool_pose(self) -> tuple[np.ndarray, tuple[float, float, float, float]]:
         """The tool tip's pose in contact_control's fixed frame (where its laws' travel is measured)."""
-        return self.world_pose(self._tf_prefix.add(self._base_frame))
+        return self.world_pose(self._base())
 
     def in_base(self, frame: str, point: np.ndarray) -> np.ndarray:
         """`point` [m], given in the tf frame `frame` (taken as it is), in contact_control's fixed frame."""
-        tf = self._lookup(self._tf_prefix.add(self._base_frame), frame).transform
+        tf = self._lookup(self._base(), frame).transform
         t, q = tf.translation, tf.rotation
         R = np.asarray(quaternion_matrix(q.x, q.y, q.z, q.w))
         return R @ np.asarray(point, dtype=float) + np.array([t.x, t.y, t.z])
