@@ -300,6 +300,25 @@ def test_real_time_factor_and_cpu_are_printed(ur5, capsys):
     assert all(m.data > 0.0 for m in samples)
 
 
+def test_a_display_that_refuses_leaves_the_driver_running_headless_and_saying_why(driver, ros_node):
+    """~viewer with a DISPLAY nobody serves: MuJoCo's viewer would end the process; the driver goes on."""
+    ns = "/md_refused"
+    ros_node.set_param(f"{ns}/robot_description", ros_node.get_param(f"{NS}/robot_description"))
+    params = {"scene_config": str(CONFIG / "sim.yaml"), "viewer": True}
+    env = {**{k: v for k, v in os.environ.items() if k != "WAYLAND_DISPLAY"}, "DISPLAY": ":65000"}
+    joints = Collector(f"{ns}/joint_states", JointState)
+    try:
+        with run_node("mujoco_driver", "mujoco_driver", args=[f"__ns:={ns}"], params=params,
+                      name="mujoco_driver", env=env) as h:
+            wait_until(lambda: "running headless" in h.output(), 30, "the headless warning")
+            assert "Failed to open display :65000" in h.output(), h.output()[-2000:]
+            joints.clear()
+            joints.wait_for(20)  # still simulating after the refusal
+            assert h.proc.poll() is None, h.output()[-2000:]
+    finally:
+        joints.close()
+
+
 def test_sim_time_mode_publishes_a_clock_that_stamps_the_state_and_survives_reset(driver, ros_node):
     """~publish_clock with real_time_factor 0: /clock advances as fast as the machine allows, the joint states
     carry simulated time, and ~reset does not turn the clock back. ~viewer without a DISPLAY: headless."""

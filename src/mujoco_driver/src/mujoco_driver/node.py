@@ -307,10 +307,14 @@ class MujocoDriverNode:
             rospy.logwarn("mujoco_driver: ~viewer is true but there is no DISPLAY: running headless")
             return None
         try:
+            refused = _display_refusal()
+            if refused:  # MuJoCo's viewer would end the whole process on it
+                rospy.logwarn("mujoco_driver: cannot open the viewer (%s): running headless", refused)
+                return None
             import mujoco.viewer
 
             return mujoco.viewer.launch_passive(self._stepper.model, self._stepper.data)
-        except Exception as exc:  # any GL/GLFW failure: go on headless
+        except Exception as exc:  # any other GL/GLFW failure: go on headless
             rospy.logwarn("mujoco_driver: cannot open the viewer (%s): running headless", exc)
             return None
 
@@ -321,6 +325,19 @@ class MujocoDriverNode:
             return
         with self._lock:
             self._viewer.sync()
+
+
+def _display_refusal() -> str:
+    """Why GLFW cannot open the display, '' if it can (MuJoCo's viewer exits the process when it cannot)."""
+    import warnings
+
+    import glfw
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        if glfw.init():
+            return ""
+    return "; ".join(str(w.message) for w in caught) or "glfwInit failed"
 
 
 def serve(name: str, build: Callable[[], MujocoDriverNode], argv: list[str] | None = None,

@@ -149,8 +149,9 @@ class DriverSettings:
     )
     viewer: bool = param(
         False,
-        doc="MuJoCo's passive viewer (only when `DISPLAY` or `WAYLAND_DISPLAY` is set; otherwise a warning "
-        "and headless); mouse perturbations work, pushes go on while it is open",
+        doc="MuJoCo's passive viewer (only when `DISPLAY` or `WAYLAND_DISPLAY` is set and the display "
+        "answers; otherwise a warning with the reason and headless); mouse perturbations work, pushes go on "
+        "while it is open",
     )
     viewer_period: float = _pos(1.0 / 30.0, "s", "viewer refresh period")
     joint_states_topic: str = _topic("joint_states", "sensor_msgs/JointState output")
