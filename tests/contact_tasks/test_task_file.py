@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import pathlib
 
+import numpy as np
 import pytest
 import yaml
 from contact_tasks.task import TaskError
@@ -64,6 +65,17 @@ def test_a_task_may_name_the_body_region_jog_arm_guards_while_it_runs():
     assert parse_task(with_change("body_region", "face"), "probe.yaml").body_region == "face"
 
 
+def test_a_steps_laws_may_act_along_a_named_tf_frame_and_the_request_carries_it():
+    from contact_tasks.run import Observation, TaskRun
+
+    def sent(law_frame: str) -> str:
+        task = parse_task(with_change("steps.down.law_frame", law_frame), "probe.yaml")
+        return TaskRun(task, tool_frame="tool_tip").start(Observation(t=0.0, tool=np.eye(4))).laws.frame
+
+    assert sent("hole_frame") == "hole_frame"  # contact_control refuses it, with the reason, if tf has none
+    assert (sent("fixed"), sent("tool")) == ("", "tool_tip")
+
+
 def test_every_shipped_task_file_loads():
     files = sorted(SHIPPED.glob("*.yaml"))
     assert files
@@ -114,6 +126,7 @@ BAD = [
     ("steps", {}, "steps: a task needs at least one step"),
     ("steps.down", [1, 2], "steps.down: expected a mapping of keys"),
     ("body_region", "hands", "body_region: must be one of ('', 'off', 'skull'"),
+    ("steps.down.law_frame", "the hole", "steps.down.law_frame: 'the hole' is not a tf frame name"),
 ]
 
 

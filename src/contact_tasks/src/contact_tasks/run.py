@@ -110,7 +110,8 @@ class TaskRun:
 
     def __init__(self, task: Task, horizon: float = 0.0, horizon_step: float = 0.02,
                  tool_frame: str = "tool_tip") -> None:
-        """`tool_frame`: contact_control's eef_frame, the axes of a step with `law_frame: tool`."""
+        """`tool_frame`: contact_control's eef_frame, the axes of a step with `law_frame: tool` (another
+        name than fixed and tool is a tf frame, passed on as it is)."""
         self.task = task
         self.tool_frame = tool_frame
         self._ahead = (round(horizon / horizon_step) if horizon > 0.0 else 0, horizon_step)
@@ -213,7 +214,8 @@ class TaskRun:
         return Command(name, laws=laws, restart=restart, reference=reference)
 
     def _law_frame(self, step: Step) -> str:
-        return self.tool_frame if step.law_frame == "tool" else ""
+        """ConfigureLaws' frame for the step: "" (control_frame), the tool's, or the tf frame it names."""
+        return {"fixed": "", "tool": self.tool_frame}.get(step.law_frame, step.law_frame)
 
     def _point(self, step_t: float, tool: FloatArray) -> PatternPoint:
         """The step's pattern at `step_t`; a path's also in `path_point`. A path is done once its reference

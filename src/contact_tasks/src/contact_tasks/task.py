@@ -152,9 +152,11 @@ class _StepKeys:
     frame: str = param("tool", choices=("tool", "fixed"), doc="the pattern's axes: the tool's at the step's "
                        "start, or contact_control's fixed frame")
     exits: list[object] = param([], type="any", doc="a list of exits (below), the first that holds is taken")
-    law_frame: str = param("fixed", choices=("fixed", "tool"),
-                           doc="the laws' axes: contact_control's control_frame, or the tool's (its "
-                           "eef_frame, turning with it: pressing along the tool's axis on a curved part)")
+    law_frame: str = param("fixed",
+                           doc="the laws' axes: `fixed`, contact_control's control_frame; `tool`, the tool's "
+                           "(its eef_frame, turning with it: pressing along the tool's axis on a curved "
+                           "part); any other name, that tf frame as contact_control looks it up (a part's "
+                           "frame from a fixture or a camera)")
 
 
 @dataclass(frozen=True)

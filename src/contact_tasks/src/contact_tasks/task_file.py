@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import difflib
 import pathlib
+import re
 from collections.abc import Mapping
 from dataclasses import replace
 
@@ -50,6 +51,7 @@ _PATTERN_KEYS = {
     "path": ("poses", "speed", "forces", "angular_speed", "ramp"),
 }
 _THRESHOLD_EXITS = ("force", "travel", "depth")
+_TF_NAME = re.compile(r"[A-Za-z0-9_./-]+")
 
 
 def load_task_file(path: str | pathlib.Path, overrides: str = "") -> Task:
@@ -187,8 +189,12 @@ class _Parser:
                                 "give at least one axis law: path")
         if pattern.type == "path":
             pattern = self.path(pattern, laws, where)
+        law_frame = str(keys.get("law_frame", "fixed"))
+        if not _TF_NAME.fullmatch(law_frame):
+            raise _RefusedError(f"{where}law_frame: {law_frame!r} is not a tf frame name (fixed, tool, or a "
+                                "frame's name: letters, digits, _ . / -)")
         return Step(laws=laws, pattern=pattern, frame=str(keys.get("frame", "tool")), exits=exits,
-                    law_frame=str(keys.get("law_frame", "fixed")))
+                    law_frame=law_frame)
 
     def path(self, pattern: Pattern, laws: Mapping[str, Law], where: str) -> Pattern:
         """A path pattern checked: its poses make a path, one force per segment for a force-tracking axis."""
