@@ -74,6 +74,13 @@ def test_a_steps_laws_may_act_along_a_named_tf_frame_and_the_request_carries_it(
 
     assert sent("hole_frame") == "hole_frame"  # contact_control refuses it, with the reason, if tf has none
     assert (sent("fixed"), sent("tool")) == ("", "tool_tip")
+    # the tool's axes where the step began: the node puts that pose on tf under the run's start_frame
+    task = parse_task(with_change("steps.down.law_frame", "tool_at_start"), "probe.yaml")
+    tool = np.eye(4)
+    tool[:3, 3] = (0.4, 0.1, 0.3)
+    command = TaskRun(task, start_frame="here").start(Observation(t=0.0, tool=tool))
+    assert command.laws.frame == "here" and np.array_equal(command.frame_pose, tool)
+    assert TaskRun(parse_task(GOOD, "probe.yaml")).start(Observation(t=0.0, tool=tool)).frame_pose is None
 
 
 def test_every_shipped_task_file_loads():

@@ -1,7 +1,8 @@
 """End to end: task_server's ~execute on the simulated UR5. A task touches the block under the tool, presses
 8 N and rubs 20 mm along X (a line pattern with the path law on X and Y); the result names its steps and
 peaks. Cancelled mid-rub the arm stops and the action says so; a bad task file is refused with its key and
-nothing moves. A task's body region (ISO/TS 15066) holds on jog_arm while it runs, the robot's after."""
+nothing moves. Laws along the tool's axes at the step's start go straight while the tool turns. A task's body
+region (ISO/TS 15066) holds on jog_arm while it runs, the robot's after."""
 
 from __future__ import annotations
 
@@ -41,6 +42,19 @@ steps:
     exits:
       - {when: pattern_done, succeed: rubbed 20 mm}
       - {when: timeout, after: 30.0, fail: too slow}
+"""
+
+TURN = """
+task: turn
+steps:
+  move:  # 20 mm along the tool's axis while it turns 0.25 rad about its x
+    law_frame: %(frame)s
+    laws:
+      z: {law: compliant_move, velocity: 0.01, damping: 2000.0, force_limit: 10.0, max_travel: 0.02}
+      rx: {law: compliant_move, velocity: 0.125, damping: 50.0, force_limit: 2.0, max_travel: 0.25}
+    exits:
+      - {when: move_ended, succeed: moved}
+      - {when: timeout, after: 15.0, fail: too slow}
 """
 
 HOLD = """
@@ -103,6 +117,21 @@ def test_a_task_touches_rubs_at_a_force_and_cancels_and_refuses(ros_node):
         client.send_goal(ExecuteTaskGoal(task="no_such_task"))
         assert client.wait_for_result(rospy.Duration(10.0))
         assert "no_such_task.yaml: cannot read the task file" in client.get_result().message
+
+        # Laws along the tool's axes as they were at the step's start: the move goes straight down while the
+        # tool turns; along the tool's turning axes it bends sideways.
+        sideways = {}
+        for frame in ("tool_at_start", "tool"):
+            assert move(name="start").success
+            before = tool()
+            client.send_goal(ExecuteTaskGoal(task_yaml=TURN % {"frame": frame}))
+            assert client.wait_for_result(rospy.Duration(30.0))
+            assert client.get_result().success, client.get_result().message
+            moved = tool()[:3] - before[:3]
+            sideways[frame] = float(np.hypot(moved[0], moved[1]))
+            assert moved[2] < -0.015, (frame, moved)
+        print(f"\nsideways while turning: {sideways}")
+        assert sideways["tool_at_start"] < 0.8e-3 < 1.5e-3 < sideways["tool"]
 
         # The task's body region holds on jog_arm while it runs; the robot's own comes back after.
         region = "/jog_arm_server/collaborative_region"

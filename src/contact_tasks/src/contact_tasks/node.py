@@ -12,6 +12,7 @@ import math
 import os
 import sys
 import threading
+import time
 from collections.abc import Callable, Sequence
 
 import actionlib
@@ -35,7 +36,7 @@ from compliant_control_msgs.msg import (
 from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsRequest
 from contact_control.frames import matrix_quaternion, quaternion_matrix
 from dynamic_reconfigure.client import Client
-from geometry_msgs.msg import Point, Pose, Quaternion
+from geometry_msgs.msg import Point, Pose, Quaternion, TransformStamped
 from std_msgs.msg import String
 from std_srvs.srv import Trigger
 
@@ -48,6 +49,8 @@ from contact_tasks.task_file import load_task, load_task_file
 __all__ = ["TaskServer", "main"]
 
 _TF_ERRORS = (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException)
+# [s] a step's frame (law_frame tool_at_start) reaches this node's tf, then contact_control's, within this
+_FRAME_WAIT = 2.0
 _LAW_FIELDS = ("law", "damping", "stiffness", "velocity", "force_limit", "max_travel", "exceeded_action",
                "target_force")
 
@@ -65,6 +68,8 @@ class TaskServer:
         self.tf = tf2_ros.Buffer()
         self.tf_prefix = for_this_node()  # the robot's frames on tf and in messages (README, Namespaces)
         self._listener: tf2_ros.TransformListener | None = None
+        self._broadcaster: tf2_ros.StaticTransformBroadcaster | None = None  # the step frame's, once needed
+        self.step_frame = rospy.get_name().rsplit("/", 1)[-1] + "_step_start"
         self._lock = threading.Lock()
         self._status: ContactControlStatus | None = None
         self._touched = self._released = False
@@ -187,17 +192,54 @@ class TaskServer:
                 given, law = getattr(command.laws, axis), getattr(req, axis)
                 for name in _LAW_FIELDS:
                     setattr(law, name, getattr(given, name))
-            try:
-                answer = self._configure(req)
-                ok, why = answer.success, answer.message
-            except (rospy.ServiceException, rospy.ROSException) as err:
-                ok, why = False, f"configure_laws failed: {err}"
+            put = command.frame_pose is not None
+            why = self._put_step_frame(command.frame_pose) if command.frame_pose is not None else ""
+            ok = not why
+            if ok:
+                ok, why = self._send_laws(req, put)
             self._laws_at = rospy.get_time()
             if not ok:
                 return self._apply(run, run.refused(why, obs), obs)
         if command.stop:
             self._call_stop()
         return command
+
+    def _send_laws(self, req: ConfigureLawsRequest, frame_put: bool) -> tuple[bool, str]:
+        """ConfigureLaws: (accepted, contact_control's message). A step frame just put on tf may reach
+        contact_control a moment after this node: its "not available" is asked again until _FRAME_WAIT."""
+        deadline = time.monotonic() + _FRAME_WAIT
+        while True:
+            try:
+                answer = self._configure(req)
+            except (rospy.ServiceException, rospy.ROSException) as err:
+                return False, f"configure_laws failed: {err}"
+            if answer.success or not frame_put or "is not available" not in answer.message \
+                    or time.monotonic() > deadline:
+                return answer.success, answer.message
+            time.sleep(0.01)
+
+    def _put_step_frame(self, pose: FloatArray) -> str:
+        """`step_frame` on tf (static) at the tool's `pose` in the fixed frame; "" once this node's own tf
+        has it, else why not."""
+        if self._broadcaster is None:
+            self._broadcaster = tf2_ros.StaticTransformBroadcaster()
+        parent, child = self.tf_prefix.add(self.fixed_frame), self.tf_prefix.add(self.step_frame)
+        msg = TransformStamped()
+        msg.header.stamp, msg.header.frame_id, msg.child_frame_id = rospy.Time.now(), parent, child
+        t, q = msg.transform.translation, msg.transform.rotation
+        t.x, t.y, t.z = (float(v) for v in pose[:3, 3])
+        q.x, q.y, q.z, q.w = matrix_quaternion(pose[:3, :3].tolist())
+        self._broadcaster.sendTransform(msg)
+        deadline = time.monotonic() + _FRAME_WAIT
+        while time.monotonic() < deadline and not rospy.is_shutdown():
+            try:
+                got = self.tf.lookup_transform(parent, child, rospy.Time(0)).transform.translation
+                if abs(got.x - t.x) + abs(got.y - t.y) + abs(got.z - t.z) < 1e-9:
+                    return ""
+            except _TF_ERRORS:
+                pass
+            time.sleep(0.005)
+        return f"the step's frame {child} did not reach tf within {_FRAME_WAIT:g} s"
 
     def _call_stop(self) -> None:
         try:
@@ -321,7 +363,7 @@ class TaskServer:
             except TaskError as err:
                 return None, str(err)
         self._laws_at = math.inf
-        run = TaskRun(task, self.s.path_horizon, self.s.path_horizon_step, self.eef_frame)
+        run = TaskRun(task, self.s.path_horizon, self.s.path_horizon_step, self.eef_frame, self.step_frame)
         obs = self._observe(tool)
         self._apply(run, run.start(obs), obs)
         rate, every = rospy.Rate(self.s.rate), max(1, round(self.s.rate / self.s.feedback_rate))

@@ -22,11 +22,13 @@ from contact_tasks.patterns import PatternPoint, evaluate
 from contact_tasks.task import AXIS_NAMES, Exit, Law, Pattern, Step, Task
 from contact_tasks.task_file import laws_request
 
-__all__ = ["CANCELLED", "FAILED", "RUNNING", "SUCCEEDED", "Command", "Observation", "TaskRun"]
+__all__ = ["CANCELLED", "FAILED", "RUNNING", "SUCCEEDED", "TOOL_AT_START", "Command", "Observation",
+           "TaskRun"]
 
 RUNNING, SUCCEEDED, FAILED, CANCELLED = "running", "succeeded", "failed", "cancelled"
 ARRIVED = 0.002  # [m] a path's end is reached this close to its last pose, across the tool's axis
 _RETRACT = "retract"  # the built-in on-failure step's name in results
+TOOL_AT_START = "tool_at_start"  # law_frame: the tool's axes where the step began, not turning after
 _DIRECTIONS = {"x": 0, "y": 1, "z": 2}
 
 
@@ -81,6 +83,8 @@ class Command:
             its law type on from the running move (its travel too), and a step's travel counts from its start.
         reference: the path reference to publish now, or None (the step has no path law).
         stop: stop contact_control's move (the task ended).
+        frame_pose: the tool's 4x4 pose (fixed frame) to put on tf as `start_frame` before `laws` are sent
+            (a step whose laws act along the tool's axes at its start), or None.
         outcome: RUNNING, SUCCEEDED, FAILED or CANCELLED; reason: why it ended.
     """
 
@@ -91,6 +95,7 @@ class Command:
     stop: bool = False
     outcome: str = RUNNING
     reason: str = ""
+    frame_pose: FloatArray | None = None
 
 
 @dataclass
@@ -109,11 +114,13 @@ class TaskRun:
     """One run of a task; `start`, then `update` every cycle until the outcome is not RUNNING."""
 
     def __init__(self, task: Task, horizon: float = 0.0, horizon_step: float = 0.02,
-                 tool_frame: str = "tool_tip") -> None:
-        """`tool_frame`: contact_control's eef_frame, the axes of a step with `law_frame: tool` (another
-        name than fixed and tool is a tf frame, passed on as it is)."""
+                 tool_frame: str = "tool_tip", start_frame: str = "task_step_start") -> None:
+        """`tool_frame`: contact_control's eef_frame, the axes of a step with `law_frame: tool`;
+        `start_frame`: the tf frame the node puts where the tool is when a step with `law_frame:
+        tool_at_start` begins (another name is a tf frame, passed on as it is)."""
         self.task = task
         self.tool_frame = tool_frame
+        self.start_frame = start_frame
         self._ahead = (round(horizon / horizon_step) if horizon > 0.0 else 0, horizon_step)
         self.result = Result()
         self.step_name = ""
@@ -211,11 +218,14 @@ class TaskRun:
         self.path_point, self._force = None, math.nan
         reference = self._reference(self._point(0.0, obs.tool), 0.0) if _has_path(step) else None
         laws = self._segment_laws() or laws_request(step.laws, self._law_frame(step))
-        return Command(name, laws=laws, restart=restart, reference=reference)
+        pose = obs.tool.copy() if step.law_frame == TOOL_AT_START else None
+        return Command(name, laws=laws, restart=restart, reference=reference, frame_pose=pose)
 
     def _law_frame(self, step: Step) -> str:
-        """ConfigureLaws' frame for the step: "" (control_frame), the tool's, or the tf frame it names."""
-        return {"fixed": "", "tool": self.tool_frame}.get(step.law_frame, step.law_frame)
+        """ConfigureLaws' frame for the step: "" (control_frame), the tool's (turning with it, or as it was at
+        the step's start), or the tf frame it names."""
+        known = {"fixed": "", "tool": self.tool_frame, TOOL_AT_START: self.start_frame}
+        return known.get(step.law_frame, step.law_frame)
 
     def _point(self, step_t: float, tool: FloatArray) -> PatternPoint:
         """The step's pattern at `step_t`; a path's also in `path_point`. A path is done once its reference

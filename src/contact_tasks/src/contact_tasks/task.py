@@ -155,8 +155,9 @@ class _StepKeys:
     law_frame: str = param("fixed",
                            doc="the laws' axes: `fixed`, contact_control's control_frame; `tool`, the tool's "
                            "(its eef_frame, turning with it: pressing along the tool's axis on a curved "
-                           "part); any other name, that tf frame as contact_control looks it up (a part's "
-                           "frame from a fixture or a camera)")
+                           "part); `tool_at_start`, the tool's as they were when the step began (they do not "
+                           "turn when the tool does); any other name, that tf frame as contact_control looks "
+                           "it up (a part's frame from a fixture or a camera)")
 
 
 @dataclass(frozen=True)
