@@ -118,6 +118,27 @@ def test_a_killed_node_leaves_nothing_registered_for_the_next_one(ros_node):
     assert master.lookupNode("/test", "/harness_killed")[0] != 1
 
 
+def test_a_stale_node_from_outside_the_harness_is_forgotten_before_the_next_launch(ros_node):
+    """A registration whose node is gone (its API refuses connections) and which no harness launch made is
+    forgotten before the next launch starts: a new node given that API's port by the OS would otherwise be
+    shut down when a node of the stale name registers (named_poses' FollowJointTrajectory tests lost theirs
+    so)."""
+    import os
+    import socket
+    import xmlrpc.client
+
+    master = xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"])
+    with socket.socket() as probe:  # a port nothing listens on: the stale node's API
+        probe.bind(("127.0.0.1", 0))
+        dead_api = f"http://127.0.0.1:{probe.getsockname()[1]}/"
+    topic, kind = "/harness_stale_topic", "std_msgs/Empty"
+    assert master.registerPublisher("/harness_stale", topic, kind, dead_api)[0] == 1
+    assert master.lookupNode("/test", "/harness_stale")[0] == 1
+    identity = ["0", "0", "0", "0", "0", "0", "a", "b"]
+    with run_node("tf2_ros", "static_transform_publisher", args=identity):
+        assert master.lookupNode("/test", "/harness_stale")[0] != 1
+
+
 def test_launch_waits_report_a_missing_topic(ros_node):
     identity = ["0", "0", "0", "0", "0", "0", "a", "b"]
     with run_node("tf2_ros", "static_transform_publisher", args=identity) as node:

@@ -7,8 +7,10 @@ import contextlib
 import fcntl
 import os
 import pathlib
+import socket
 import subprocess
 import tempfile
+import urllib.parse
 import xmlrpc.client
 from collections.abc import Iterator, Mapping, Sequence
 
@@ -101,6 +103,18 @@ def process_slot() -> Iterator[None]:
             fcntl.flock(slot, fcntl.LOCK_UN)
 
 
+def _answers(api: str) -> bool:
+    """Whether a node's XML-RPC API at `api` accepts a connection (a slow node answers late, still alive)."""
+    try:
+        parts = urllib.parse.urlsplit(api)
+        with socket.create_connection((parts.hostname, parts.port), timeout=1.0):
+            return True
+    except ConnectionRefusedError:
+        return False
+    except (OSError, ValueError):
+        return True  # unreachable for another reason: not known to be gone
+
+
 @contextlib.contextmanager
 def _spawn(cmd: Sequence[str], env: Mapping[str, str] | None) -> Iterator[Launched]:
     with process_slot(), _spawned(cmd, env) as launched:
@@ -111,6 +125,7 @@ def _spawn(cmd: Sequence[str], env: Mapping[str, str] | None) -> Iterator[Launch
 def _spawned(cmd: Sequence[str], env: Mapping[str, str] | None) -> Iterator[Launched]:
     log = tempfile.NamedTemporaryFile(prefix="harness_", suffix=".log", delete=False)
     uri = dict(os.environ if env is None else env).get("ROS_MASTER_URI")
+    _forget_dead_nodes(uri, _registered_nodes(_system_state(uri)), check=True)
     before = _registered_nodes(_system_state(uri))
     proc = subprocess.Popen(
         list(cmd),
@@ -125,7 +140,9 @@ def _spawned(cmd: Sequence[str], env: Mapping[str, str] | None) -> Iterator[Laun
         yield launched
     finally:
         launched.stop()
-        _forget_dead_nodes(uri, before)
+        state = _system_state(uri)
+        _forget_dead_nodes(uri, _registered_nodes(state) - before)
+        _forget_dead_nodes(uri, _registered_nodes(_system_state(uri)), check=True)
         log.close()
         os.unlink(log.name)
 
@@ -146,20 +163,22 @@ def _registered_nodes(state: list | None) -> set[str]:
     return {node for kind in state or () for _name, nodes in kind for node in nodes}
 
 
-def _forget_dead_nodes(uri: str | None, before: set[str]) -> None:
-    """Unregisters what the stopped process's nodes left with the master (`rosnode cleanup`). A node killed
-    before it unregistered (SIGKILL after the stop timeout) stays registered under its name and API; when the
-    next test's node of that name registers, the master sends "new node registered with same name" to the
-    old API, and a new node that got the same port from the OS is the one shut down (a panda replay test's
-    named_poses died that way: control_stack's stale API was its port)."""
+def _forget_dead_nodes(uri: str | None, nodes: set[str], check: bool = False) -> None:
+    """Unregisters what `nodes` left with the master (`rosnode cleanup`); `check`: only those whose API
+    refuses a connection (gone). A node killed before it unregistered (SIGKILL after the stop timeout)
+    stays registered under its name and API; when the next test's node of that name registers, the master
+    sends "new node registered with same name" to the old API, and a new node that got the same port from
+    the OS is the one shut down (a panda replay test's named_poses died that way: control_stack's stale API
+    was its port; named_poses' FollowJointTrajectory tests lost theirs the same way to a stale node from
+    before their launch): so before each launch too, every node that no longer answers is forgotten."""
     state = _system_state(uri)
     if state is None or uri is None:
         return
     master = xmlrpc.client.ServerProxy(uri)
     publishers, subscribers, services = state
-    for node in _registered_nodes(state) - before:
+    for node in _registered_nodes(state) & nodes:
         code, _msg, api = master.lookupNode("/harness", node)
-        if code != 1:
+        if code != 1 or (check and _answers(api)):
             continue
         for topic, nodes in publishers:
             if node in nodes:
