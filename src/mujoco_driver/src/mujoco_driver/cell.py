@@ -16,7 +16,7 @@ import numpy as np
 
 from mujoco_driver.config import SceneConfig
 from mujoco_driver.scene import SceneError, arm_spec, index_scene, rpy_to_quat
-from mujoco_driver.sim import Simulation
+from mujoco_driver.sim import Simulation, step_arms
 
 __all__ = ["CellArm", "World"]
 
@@ -60,28 +60,27 @@ class World:
                 raise SceneError(f"arm {arm.name}: timestep {arm.scene.timestep} s / {arm.scene.integrator} "
                                  f"differs from {arms[0].name}'s {first.timestep} s / {first.integrator}: "
                                  "one world steps them all at once")
-        specs = []
+        placed = []  # (arm, its spec, its base pose: x, y, z, qw, qx, qy, qz)
         for arm in arms:
             try:
-                specs.append(arm_spec(arm.urdf, arm.scene, mesh_cache))
+                spec = arm_spec(arm.urdf, arm.scene, mesh_cache)
             except SceneError as exc:
                 raise SceneError(f"arm {arm.name}: {exc}") from None
-        world = mujoco.MjSpec()
-        world.option.timestep = specs[0].spec.option.timestep
-        world.option.integrator = specs[0].spec.option.integrator
-        bases = []
-        for arm, spec in zip(arms, specs, strict=True):
             base = np.concatenate((np.asarray(arm.position, float), rpy_to_quat(arm.rpy)))
+            placed.append((arm, spec, base))
+        world = mujoco.MjSpec()
+        world.option.timestep = placed[0][1].spec.option.timestep
+        world.option.integrator = placed[0][1].spec.option.integrator
+        for arm, spec, base in placed:
             frame = world.worldbody.add_frame(pos=base[:3], quat=base[3:])
             world.attach(spec.spec, prefix=f"{arm.name}/", frame=frame)
-            bases.append(base)
         try:
             self.model = world.compile()
         except ValueError as exc:
             raise SceneError(f"MuJoCo cannot compile the cell: {exc}") from exc
         self.data = mujoco.MjData(self.model)
         self.arms: dict[str, Simulation] = {}
-        for arm, spec, base in zip(arms, specs, bases, strict=True):
+        for arm, spec, base in placed:
             scene = index_scene(self.model, spec, f"{arm.name}/")
             self.arms[arm.name] = Simulation.in_world(self, arm.scene, scene, base)
         self._arms = list(self.arms.values())
@@ -109,11 +108,4 @@ class World:
 
     def step(self, n: int = 1) -> None:
         """Advance every arm ``n`` timesteps, each following its own command."""
-        model, data, arms = self.model, self.data, self._arms
-        for _ in range(n):
-            for arm in arms:
-                arm._before_step()
-            mujoco.mj_step2(model, data)
-            for arm in arms:
-                arm._after_step()
-            mujoco.mj_step1(model, data)
+        step_arms(self.model, self.data, self._arms, n)

@@ -33,7 +33,7 @@ from compliant_common.errors import StackError
 from mujoco_driver.config import SceneConfig
 from mujoco_driver.scene import SceneModel, build_scene
 
-__all__ = ["CommandError", "Simulation", "TrajectoryPoint"]
+__all__ = ["CommandError", "Simulation", "TrajectoryPoint", "step_arms"]
 
 MODE_POSITION, MODE_VELOCITY, MODE_TRAJECTORY = "position", "velocity", "trajectory"
 # [1/s] Trajectory mode: the setpoint closes a position gap to the interpolated path with this rate (a 33 ms
@@ -428,13 +428,7 @@ class Simulation:
         if self._world is not None:
             self._world.step(n)
             return
-        model, data = self.model, self.data
-        for _ in range(n):
-            self._before_step()
-            mujoco.mj_step2(model, data)
-            self._after_step()
-            # Position stage for the new state, so poses and qpos always agree between calls.
-            mujoco.mj_step1(model, data)
+        step_arms(self.model, self.data, (self,), n)
 
     def _before_step(self) -> None:
         self._update_setpoint()
@@ -556,3 +550,15 @@ class Simulation:
         q[:] = (2 * s3 - 3 * s2 + 1) * p0 + (s3 - 2 * s2 + s) * v0 + (-2 * s3 + 3 * s2) * p1 + (s3 - s2) * v1
         qd[:] = ((6 * s2 - 6 * s) * p0 + (3 * s2 - 4 * s + 1) * v0
                  + (-6 * s2 + 6 * s) * p1 + (3 * s2 - 2 * s) * v1) / h
+
+
+def step_arms(model: mujoco.MjModel, data: mujoco.MjData, arms: Sequence[Simulation], n: int) -> None:
+    """`n` timesteps of `data`, each of `arms` (an arm alone, or a cell's) following its own command."""
+    for _ in range(n):
+        for arm in arms:
+            arm._before_step()
+        mujoco.mj_step2(model, data)
+        for arm in arms:
+            arm._after_step()
+        # Position stage for the new state, so poses and qpos always agree between calls.
+        mujoco.mj_step1(model, data)
