@@ -13,6 +13,7 @@ import tempfile
 import urllib.parse
 import xmlrpc.client
 from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Set as AbstractSet
 
 from harness.process import stop_process_group
 from harness.waiting import wait_until
@@ -125,7 +126,7 @@ def _spawn(cmd: Sequence[str], env: Mapping[str, str] | None) -> Iterator[Launch
 def _spawned(cmd: Sequence[str], env: Mapping[str, str] | None) -> Iterator[Launched]:
     log = tempfile.NamedTemporaryFile(prefix="harness_", suffix=".log", delete=False)
     uri = dict(os.environ if env is None else env).get("ROS_MASTER_URI")
-    _forget_dead_nodes(uri, _registered_nodes(_system_state(uri)), check=True)
+    _forget_dead_nodes(uri, check=True)
     before = _registered_nodes(_system_state(uri))
     proc = subprocess.Popen(
         list(cmd),
@@ -140,9 +141,7 @@ def _spawned(cmd: Sequence[str], env: Mapping[str, str] | None) -> Iterator[Laun
         yield launched
     finally:
         launched.stop()
-        state = _system_state(uri)
-        _forget_dead_nodes(uri, _registered_nodes(state) - before)
-        _forget_dead_nodes(uri, _registered_nodes(_system_state(uri)), check=True)
+        _forget_dead_nodes(uri, keep=before)
         log.close()
         os.unlink(log.name)
 
@@ -163,20 +162,21 @@ def _registered_nodes(state: list | None) -> set[str]:
     return {node for kind in state or () for _name, nodes in kind for node in nodes}
 
 
-def _forget_dead_nodes(uri: str | None, nodes: set[str], check: bool = False) -> None:
-    """Unregisters what `nodes` left with the master (`rosnode cleanup`); `check`: only those whose API
-    refuses a connection (gone). A node killed before it unregistered (SIGKILL after the stop timeout)
-    stays registered under its name and API; when the next test's node of that name registers, the master
-    sends "new node registered with same name" to the old API, and a new node that got the same port from
-    the OS is the one shut down (a panda replay test's named_poses died that way: control_stack's stale API
-    was its port; named_poses' FollowJointTrajectory tests lost theirs the same way to a stale node from
-    before their launch): so before each launch too, every node that no longer answers is forgotten."""
+def _forget_dead_nodes(uri: str | None, keep: AbstractSet[str] = frozenset(), check: bool = False) -> None:
+    """Unregisters what every node but those in `keep` left with the master (`rosnode cleanup`); `check`:
+    only the nodes whose API refuses a connection (gone). A node killed before it unregistered (SIGKILL after
+    the stop timeout) stays registered under its name and API; when the next test's node of that name
+    registers, the master sends "new node registered with same name" to the old API, and a new node that got
+    the same port from the OS is the one shut down (a panda replay test's named_poses died that way:
+    control_stack's stale API was its port; named_poses' FollowJointTrajectory tests lost theirs the same way
+    to a stale node from before their launch): so before each launch, every node that no longer answers is
+    forgotten too."""
     state = _system_state(uri)
     if state is None or uri is None:
         return
     master = xmlrpc.client.ServerProxy(uri)
     publishers, subscribers, services = state
-    for node in _registered_nodes(state) & nodes:
+    for node in _registered_nodes(state) - keep:
         code, _msg, api = master.lookupNode("/harness", node)
         if code != 1 or (check and _answers(api)):
             continue

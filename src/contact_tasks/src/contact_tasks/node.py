@@ -192,11 +192,11 @@ class TaskServer:
                 given, law = getattr(command.laws, axis), getattr(req, axis)
                 for name in _LAW_FIELDS:
                     setattr(law, name, getattr(given, name))
-            put = command.frame_pose is not None
-            why = self._put_step_frame(command.frame_pose) if command.frame_pose is not None else ""
+            pose = command.frame_pose
+            why = self._put_step_frame(pose) if pose is not None else ""
             ok = not why
             if ok:
-                ok, why = self._send_laws(req, put)
+                ok, why = self._send_laws(req, frame_put=pose is not None)
             self._laws_at = rospy.get_time()
             if not ok:
                 return self._apply(run, run.refused(why, obs), obs)

@@ -130,6 +130,8 @@ class StackClient:
         absolute = names.tf_prefix.startswith("/")
         self._tf_prefix = (TfPrefix(str(rospy.get_param(names.tf_prefix, ""))) if absolute
                            else for_this_node())  # the robot's frames on tf
+        eef = rospy.get_param(f"{cc}/eef_frame", ContactControlSettings.eef_frame)
+        self._eef = self._tf_prefix.add(str(eef))  # the tool tip's full tf name
         self.pose = Series(3)
         self._status = Series(6)
         self._wrench = Series(3)
@@ -307,11 +309,6 @@ class StackClient:
         """tf's transform from `source` to `target`, both full tf names."""
         return self._tf.lookup_transform(target, source, rospy.Time(0), rospy.Duration(5.0))
 
-    def _eef(self) -> str:
-        """The tool tip's full tf name (contact_control's `eef_frame`)."""
-        key = f"{self.names.contact_control}/eef_frame"
-        return self._tf_prefix.add(str(rospy.get_param(key, ContactControlSettings.eef_frame)))
-
     def _base(self) -> str:
         """contact_control's fixed frame's full tf name."""
         return self._tf_prefix.add(self._base_frame)
@@ -319,7 +316,7 @@ class StackClient:
     def world_pose(self, frame: str) -> tuple[np.ndarray, tuple[float, float, float, float]]:
         """The tool tip's (contact_control's `eef_frame`) position [m] and orientation (x, y, z, w) in the tf
         frame `frame`, taken as it is (a cell's `world`, above every arm's tf prefix)."""
-        tf = self._lookup(frame, self._eef()).transform
+        tf = self._lookup(frame, self._eef).transform
         t, q = tf.translation, tf.rotation
         return np.array([t.x, t.y, t.z]), (q.x, q.y, q.z, q.w)
 
@@ -327,7 +324,7 @@ class StackClient:
         """Whether tf has this robot's tool tip in the tf frame `frame` (taken as it is) and its sensor in
         contact_control's fixed frame: its robot_state_publisher is up and its frames hang from `frame`."""
         sensor = self._tf_prefix.add(sensor_frame)
-        return bool(self._tf.can_transform(frame, self._eef(), rospy.Time(0))
+        return bool(self._tf.can_transform(frame, self._eef, rospy.Time(0))
                     and self._tf.can_transform(self._base(), sensor, rospy.Time(0)))
 
     def tool_pose(self) -> tuple[np.ndarray, tuple[float, float, float, float]]:
