@@ -1,5 +1,6 @@
 """The test harness itself: private master, real topics, launch helpers and bags."""
 
+import contextlib
 import pathlib
 import subprocess
 
@@ -161,3 +162,23 @@ def test_with_env_passes_the_command_its_own_arguments():
     assert args == "--help|--extend|a b"
     assert str(root / "src") in package_path
     assert out.stderr == ""
+
+
+def test_a_stop_leaves_no_process_below_the_launch_even_in_a_session_of_its_own():
+    """roslaunch starts each node with setsid: a group signal misses it. A parent that ignores SIGINT is
+    killed after the timeout, and the child it started in its own session goes with it."""
+    import os
+    import signal
+
+    from harness.process import _started, stop_process_group
+
+    parent = subprocess.Popen(["bash", "-c", "trap '' INT; setsid sleep 300 & echo $!; wait"],
+                              stdout=subprocess.PIPE, text=True, start_new_session=True)
+    child = int(parent.stdout.readline())
+    assert _started(child) is not None
+    try:
+        stop_process_group(parent, timeout=0.5)
+        assert _started(child) is None, "the node-like child outlived its stopped parent"
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(child, signal.SIGKILL)

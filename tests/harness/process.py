@@ -15,9 +15,13 @@ __all__ = ["node_pid", "stalled", "stop_process_group"]
 
 
 def stop_process_group(proc: subprocess.Popen, timeout: float = 10.0) -> None:
-    """Sends SIGINT to `proc`'s process group, then SIGKILL if it is still running after `timeout` s."""
+    """Sends SIGINT to `proc`'s process group, then SIGKILL if it is still running after `timeout` s; then
+    SIGKILL to every process that was below it and still runs. roslaunch starts each node in a session of its
+    own (setsid), so a group signal misses the nodes: a roslaunch killed after the timeout left them running,
+    still registered with the master, and a later node of the same name was shut down in their place."""
     if proc.poll() is not None:
         return
+    below = _descendants(proc.pid)
     with contextlib.suppress(ProcessLookupError):
         os.killpg(proc.pid, signal.SIGINT)
     try:
@@ -26,6 +30,46 @@ def stop_process_group(proc: subprocess.Popen, timeout: float = 10.0) -> None:
         with contextlib.suppress(ProcessLookupError):
             os.killpg(proc.pid, signal.SIGKILL)
         proc.wait()
+    left = [p for p in below if _started(p[0]) == p[1]]
+    for pid, _ in left:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(pid, signal.SIGKILL)
+    deadline = time.monotonic() + 10.0
+    while any(_started(pid) == start for pid, start in left) and time.monotonic() < deadline:
+        time.sleep(0.01)
+
+
+def _stat(pid: int | str) -> list[str] | None:
+    """The fields of /proc/<pid>/stat after the command's name (state first), None if it is gone."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii", errors="replace") as handle:
+            return handle.read().rsplit(")", 1)[1].split()
+    except (OSError, IndexError):
+        return None
+
+
+def _started(pid: int) -> str | None:
+    """The start time of a running process `pid` (None once it is gone or a zombie): told apart from a later
+    process given the same pid."""
+    fields = _stat(pid)
+    return None if fields is None or fields[0] in ("Z", "X") else fields[19]
+
+
+def _descendants(pid: int) -> list[tuple[int, str]]:
+    """(pid, start time) of every process below `pid`."""
+    children: dict[int, list[int]] = {}
+    for entry in os.listdir("/proc"):
+        fields = _stat(entry) if entry.isdigit() else None
+        if fields is not None:
+            children.setdefault(int(fields[1]), []).append(int(entry))
+    found, todo = [], [pid]
+    while todo:
+        for child in children.get(todo.pop(), []):
+            start = _started(child)
+            if start is not None:
+                found.append((child, start))
+            todo.append(child)
+    return found
 
 
 def node_pid(name: str) -> int:
