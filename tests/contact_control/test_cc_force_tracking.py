@@ -16,6 +16,7 @@ from contact_control.axes import (
     EXCEEDED_MOVE_AWAY,
     LAW_COMPLIANT_MOVE,
     LAW_FORCE_TRACKING,
+    LAW_PATH,
     SAFETY_OK,
 )
 from contact_control.laws import AxisLaw, guard_pressing, law_velocity, shape_velocity
@@ -194,6 +195,63 @@ def test_on_a_rising_surface_the_force_settles_b_times_the_rise_rate_above_the_t
     assert np.ptp(held) < TOLERANCE
     # Z rose with the surface, in contact all along.
     assert loop.pose[2, 3] == pytest.approx(TABLE_Z + 0.05 * loop.pose[0, 3] - held[-1] / STIFFNESS, abs=1e-4)
+
+
+def reference(loop: ClosedLoop, x: float, t: float) -> None:
+    """The path law's reference at `x` on the X axis, moving at SPEED."""
+    loop.ctrl.set_path_reference((x, 0.0, 0.0), (0, 0, 0, 1), (SPEED, 0, 0, 0, 0, 0), t)
+
+
+def press_then_follow_x(slope: float, **params: object) -> tuple[ClosedLoop, float]:
+    """Presses for 3 s, then X follows a path reference moving at SPEED for 8 s (force tracking beside a path
+    law: the integral term runs); returns the loop and X's start."""
+    loop = ClosedLoop(controller(**params), lag=0.02)
+    loop.start(laws(z=PRESS))
+    loop.run(table(slope=slope), 3.0)
+    x0, t0 = loop.pose[0, 3], loop.t
+
+    def moving_table(t, pose):
+        reference(loop, x0 + SPEED * (t - t0), t)
+        return table(slope=slope)(t, pose)
+
+    loop.ctrl.set_path_reference((x0, 0.0, 0.0), (0, 0, 0, 1), (0,) * 6, t0)
+    loop.start(laws(z=PRESS, x=AxisLaw(LAW_PATH, stiffness=5.0)))
+    loop.run(moving_table, 8.0)
+    return loop, x0
+
+
+SPEED = 0.02  # [m/s] the path's
+
+
+def test_beside_a_path_the_integral_term_brings_a_rising_surface_to_the_target():
+    # The same 2 N the proportional law leaves on a 5 % rise (the test above) decays with the integral's
+    # time constant (1 s) once X slides along its path.
+    loop, x0 = press_then_follow_x(0.05)
+    assert loop.pose[0, 3] - x0 == pytest.approx(SPEED * 8.0, abs=0.002)
+    held = forces(loop, 3.0 + 5.0)  # the last 3 s
+    assert held.mean() == pytest.approx(TARGET, abs=0.3)
+    assert np.ptp(held) < TOLERANCE
+    off, _ = press_then_follow_x(0.05, force_tracking_path_integral=0.0)
+    assert forces(off, 3.0 + 5.0).mean() == pytest.approx(TARGET + 0.05 * SPEED * B, abs=TOLERANCE)
+
+
+def test_the_integral_term_holds_a_flat_surface_and_never_winds_up_off_it():
+    loop, _ = press_then_follow_x(0.0)
+    held = forces(loop, 3.0)
+    assert np.all(np.abs(held - TARGET) <= TOLERANCE), (held.min(), held.max())
+    # The table falls away 5 mm: out of contact the axis approaches at its approach speed, no faster, and
+    # touches again without overshooting more than a plain touch does.
+    x0, t0 = loop.pose[0, 3], loop.t
+
+    def falling(t, pose):
+        reference(loop, x0 + SPEED * (t - t0), t)
+        return table(step_at=t0, step=-0.005)(t, pose)
+
+    loop.run(falling, 3.0)
+    after = loop.velocities()[round(t0 / DT):, 2]
+    assert after.min() >= -PRESS.velocity - 1e-9  # never faster than the approach speed toward the table
+    again = forces(loop, t0 + 1.5)
+    assert again.max() < TARGET + 3.0 and again[-1] == pytest.approx(TARGET, abs=TOLERANCE)
 
 
 def test_a_force_limit_ends_the_press_and_move_away_lets_go():

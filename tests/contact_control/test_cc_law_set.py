@@ -33,6 +33,9 @@ def test_a_pressed_replay_compiles_to_its_axes_guards_and_path():
     assert s.floor == (False, False, False, True, True, True)  # no minimum velocity on a path or a press
     assert s.needs_travel  # the path law has a max travel
     assert not LawSet.of([press] + [NONE] * 5, (0.0,) * 6, fast_guard=False).guarded[0]
+    # the press integrates beside the path; alone it stays proportional
+    assert s.integrating == (False, False, True, False, False, False)
+    assert not any(LawSet.of([NONE, NONE, press, NONE, NONE, NONE], (0.0,) * 6, fast_guard=True).integrating)
 
 
 @pytest.mark.parametrize(("law", "travel"), [

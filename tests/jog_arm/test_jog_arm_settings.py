@@ -7,9 +7,12 @@ import re
 
 import numpy as np
 import pytest
+import yaml
 from jog_arm_testing import PANDA, UR5, make_jog
 
 from jog_arm import ArmModel, JogSettings, KinematicsError, SettingsError, StatusCode
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 MSG_DIR = pathlib.Path(__file__).resolve().parents[2] / "src/majorana/compliant_control_msgs/msg"
 
@@ -62,12 +65,23 @@ def test_fork_yaml_layout_is_read() -> None:
         ({"ee_frame_name": ""}, "ee_frame_name"),
         ({"held_joints": [{"head_1_joint": "up"}]}, "held_joints/head_1_joint"),
         ({"held_joints": ["head_1_joint"]}, "held_joints"),
+        ({"command_out_type": "velocity_array"}, "integrate_from"),  # commanded: trajectory output only
     ],
     ids=lambda v: v if isinstance(v, str) else None,
 )
 def test_bad_settings_refused_naming_the_key(params: dict, key: str) -> None:
     with pytest.raises(SettingsError, match=re.escape(f"jog_arm_server/{key}")):
         JogSettings.from_params(params)
+
+
+@pytest.mark.parametrize("path", sorted(ROOT.glob("src/*_custom/config/jog_arm*.yaml")),
+                         ids=lambda p: f"{p.parent.parent.name}/{p.name}")
+def test_every_robot_packages_jog_arm_file_loads_over_the_defaults(path: pathlib.Path) -> None:
+    """What each robot launch loads (jog_arm's config/jog_arm.yaml, then the package's), whatever launch
+    argument selects the file: a refused key stops jog_arm_server on the robot."""
+    params = yaml.safe_load((ROOT / "src/jog_arm/config/jog_arm.yaml").read_text())
+    params.update(yaml.safe_load(path.read_text()))
+    JogSettings.from_params(params)
 
 
 def test_held_joints_are_a_list_a_later_robot_file_replaces() -> None:

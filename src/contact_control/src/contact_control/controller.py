@@ -15,6 +15,7 @@ from contact_control.axes import End, Law, Safety
 from contact_control.cycle import CycleResult
 from contact_control.ends import EndChecks, end_reason
 from contact_control.exceeded import ExceededReaction
+from contact_control.force_integral import ForceIntegral
 from contact_control.global_limit import GlobalLimit
 from contact_control.intake import WrenchIntake
 from contact_control.law_set import LawSet
@@ -57,6 +58,7 @@ class ContactControl:
         self._path = PathReference(s.path_reference_timeout, s.path_extrapolate)
         self._path_error, self._path_velocity = [0.0] * 6, [0.0] * 6
         self._normal = NormalFollower.of(s)
+        self._integral = ForceIntegral()
         self._v, self._wrench = [0.0] * 6, [0.0] * 6
         self._move = MoveState()
         self._last_t: float | None = None
@@ -140,6 +142,7 @@ class ContactControl:
         self._ends.restart(t)
         self._v = [0.0] * 6
         self._normal.reset()
+        self._integral.reset()
         self._moved.restart(eef_pose, R_fixed_control)
         self._last_t = None
         return self._move.begin(bool(self._set.active), t)
@@ -162,6 +165,7 @@ class ContactControl:
         for i, law in enumerate(laws):
             if law.law != old[i] or not law.law:
                 self._v[i] = 0.0
+                self._integral.restart_axis(i)
                 self._moved.restart_axis(i)
                 self._ends.restart_axis(i)
         self._ends.started(t)
@@ -283,6 +287,8 @@ class ContactControl:
                 target = normal_velocity(c.laws[i], turn[i - 3]) + (reference[i] if c.path_axes else 0.0)
             else:
                 target = law_velocity(c.laws[i], tuning[i], w[i], travel[i])
+                if c.integrating[i]:
+                    target += self._integral.step(i, c.laws[i], tuning[i], w[i], dt)
                 if c.guarded[i]:
                     target = guard_pressing(c.laws[i], tuning[i], target, fast[i])
             v[i] = shape_velocity(target, v[i], tuning[i], dt, c.floor[i])

@@ -31,6 +31,8 @@ class LawSet:
         path_axes: the active axes on a path.
         watched: the active axes the oscillation watchdog watches (a path may turn on purpose).
         normal_axes: the active axes on the normal law (rx, ry).
+        integrating: per axis, force tracking toward a nonzero target beside a path law: its integral
+            term (force_integral) runs.
     """
 
     laws: tuple[AxisLaw, ...] = (AxisLaw(),) * 6
@@ -45,6 +47,7 @@ class LawSet:
     path_axes: tuple[int, ...] = ()
     watched: tuple[int, ...] = ()
     normal_axes: tuple[int, ...] = ()
+    integrating: tuple[bool, ...] = (False,) * 6
 
     @classmethod
     def of(cls, laws: Sequence[AxisLaw], diff_max: Sequence[float], fast_guard: bool) -> LawSet:
@@ -53,6 +56,7 @@ class LawSet:
         laws = tuple(laws)
         active = tuple(i for i in range(6) if laws[i].law != LAW_NONE)
         is_path = tuple(law.law == LAW_PATH for law in laws)
+        tracking = tuple(law.law == LAW_FORCE_TRACKING and law.target != 0.0 for law in laws)
         return cls(
             laws=laws,
             types=tuple(law.law for law in laws),
@@ -61,11 +65,12 @@ class LawSet:
             diff_axes=tuple(i for i in active if diff_max[i] > 0.0),
             needs_travel=any(law.law not in _NO_TRAVEL or law.max_travel > 0.0 for law in laws if law.law),
             floor=tuple(law.law not in (LAW_FORCE_TRACKING, LAW_PATH, LAW_NORMAL) for law in laws),
-            guarded=tuple(fast_guard and law.law == LAW_FORCE_TRACKING and law.target != 0.0 for law in laws),
+            guarded=tuple(fast_guard and t for t in tracking),
             is_path=is_path,
             path_axes=tuple(i for i in active if is_path[i]),
             watched=tuple(i for i in active if not is_path[i]),
             normal_axes=tuple(i for i in active if laws[i].law == LAW_NORMAL),
+            integrating=tuple(t and any(is_path) for t in tracking),
         )
 
     def with_law(self, axis: int, law: AxisLaw) -> LawSet:

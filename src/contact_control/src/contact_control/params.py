@@ -279,6 +279,11 @@ class ContactControlSettings:
         True, doc="force tracking never presses faster than (F_target - F) / b with F unfiltered once that F "
         "is in contact: a touch stops the pressing before the low-pass filter has seen it",
     )
+    force_tracking_path_integral: float = _nonneg(
+        1.0, "s", "beside a path law, force tracking adds integral action with this time constant: sliding "
+        "carries the tool off a part it is a little tilted to, which the proportional law alone follows "
+        "short of the target (README, Force tracking); 0: none"
+    )
     # normal law (ConfigureLaws NORMAL on RX/RY; README, Keeping the tool normal)
     normal_min_force: float = _pos(
         3.0, "N", "the normal law reads the contact normal from |F| at or above this; below it the tool's "
@@ -383,6 +388,7 @@ class ContactControlSettings:
                 self.move_away_max_angle,
                 self.force_tracking_deadband_torque,
                 self.force_tracking_contact_fraction,
+                self.force_tracking_path_integral,
             )
         return AxisTuning(
             self.follower_deadband_force,
@@ -400,6 +406,7 @@ class ContactControlSettings:
             self.move_away_max_distance,
             self.force_tracking_deadband_force,
             self.force_tracking_contact_fraction,
+            self.force_tracking_path_integral,
         )
 
 
@@ -425,6 +432,7 @@ class AxisTuning:
     away_max_travel: float = ContactControlSettings.move_away_max_distance
     track_deadband: float = ContactControlSettings.force_tracking_deadband_force
     contact_fraction: float = ContactControlSettings.force_tracking_contact_fraction
+    track_integral_time: float = ContactControlSettings.force_tracking_path_integral
 
 
 PARAMETERS = schema_of(ContactControlSettings)
@@ -436,7 +444,8 @@ TUNABLE = (
     "max_velocity", "acceleration_linear", "deceleration_linear", "acceleration_angular",
     "deceleration_angular",
     "min_velocity_linear", "min_velocity_angular", "follower_deadband_force", "follower_deadband_torque",
-    "force_tracking_deadband_force", "force_tracking_deadband_torque", "lp_filter_cutoff_freq",
+    "force_tracking_deadband_force", "force_tracking_deadband_torque", "force_tracking_path_integral",
+    "lp_filter_cutoff_freq",
     "global_max_force", "global_max_torque", "guide_damping_linear", "guide_damping_angular",
     "guide_max_velocity_linear", "guide_max_velocity_angular", "compliant_default_velocity_linear",
     "move_away_velocity_linear", "normal_min_force", "normal_max_rate", "normal_jump", "normal_friction",

@@ -184,7 +184,11 @@ class JogSettings:
         (), type="floats", unit="rad", shown_range="one per joint",
         doc="one value per joint; `[]` = posture when motion starts",
     )
-    integrate_from: str = param("commanded", choices=INTEGRATE_FROM, doc="reference of the next point")
+    integrate_from: str = param(
+        "commanded", choices=INTEGRATE_FROM,
+        doc="reference of the next point; `commanded` only with `command_out_type` trajectory (a robot "
+        "driven by velocities moves on over a late cycle, which a commanded reference does not)",
+    )
     max_tracking_error: float = _nonneg(
         0.2, "rad", "commanded vs measured beyond this: restart from measured; 0 = never"
     )
@@ -310,6 +314,15 @@ class JogSettings:
             raise SettingsError(
                 f"{prefix}contact_guard_slow_force must be below contact_guard_max_force "
                 f"({self.contact_guard_max_force} N), got {self.contact_guard_slow_force}"
+            )
+        if self.integrate_from == "commanded" and self.command_out_type == "velocity_array":
+            # The robot holds a velocity over a late cycle; the commanded reference advances one pub_period
+            # per cycle: it falls behind the arm (README, integrate_from).
+            raise SettingsError(
+                f"{prefix}integrate_from: commanded needs {prefix}command_out_type trajectory; with "
+                "velocity_array set integrate_from: measured (the robot integrates the velocities itself, "
+                "over the real time between commands, so a reference integrated over pub_period drifts "
+                "from the arm whenever a cycle is late)"
             )
         if len(set(self.joint_names)) != len(self.joint_names):
             raise SettingsError(f"{prefix}joint_names has duplicates: {list(self.joint_names)}")

@@ -69,11 +69,14 @@ robot_stop:
 
 def _pub_period(d: DriverInterface) -> str:
     """jog_arm's cycle for a driver: its filter acts per cycle, so for a velocity controller (which takes the
-    newest command each of its periods) a short cycle keeps the lag small; trajectories stay at 8 ms."""
+    newest command each of its periods) a short cycle keeps the lag small, and each cycle starts from the
+    measured joints; trajectories stay at 8 ms."""
     if d.jog_command == "velocity":
         # The UR3 on the emulated 125 Hz ur_robot_driver at 8 ms (the driver's period): follower, compliant
         # move and hybrid failed, the axes ringing; at 4 ms they pass.
-        return "pub_period: 0.004                   # [s] shorter than the driver's period: less lag (robot_setup README)"
+        return ("pub_period: 0.004                   # [s] shorter than the driver's period: less lag (robot_setup README)\n"
+                "integrate_from: measured            # velocities out: each cycle starts from the measured joints (the robot\n"
+                "                                    #   moves on over a late cycle; jog_arm README, integrate_from)")
     return "pub_period: 0.008"
 
 
