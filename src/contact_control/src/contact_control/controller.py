@@ -19,7 +19,7 @@ from contact_control.force_integral import ForceIntegral
 from contact_control.global_limit import GlobalLimit
 from contact_control.intake import WrenchIntake
 from contact_control.law_set import LawSet
-from contact_control.laws import AxisLaw, guard_pressing, law_velocity, path_velocity, shape_velocity
+from contact_control.laws import AxisLaw, law_velocity, path_velocity, shape_velocity
 from contact_control.loop_gain import GainBound
 from contact_control.move import MoveState
 from contact_control.normal import NormalFollower, normal_velocity
@@ -138,18 +138,18 @@ class ContactControl:
         if self._move.active:
             self._end_move(-1, End.EXTERNAL_STOP, False, "replaced by a new request")
         self._reaction.clear()
-        self._adopt(laws)
+        self._adopt(laws, fresh=True)
         self._ends.restart(t)
         self._v = [0.0] * 6
         self._normal.reset()
-        self._integral.reset()
         self._moved.restart(eef_pose, R_fixed_control)
         self._last_t = None
         return self._move.begin(bool(self._set.active), t)
 
-    def _adopt(self, laws: list[AxisLaw]) -> None:
-        """Six laws compiled for the cycles (a new move's or a changed one's)."""
+    def _adopt(self, laws: list[AxisLaw], fresh: bool = False) -> None:
+        """Six laws compiled for the cycles (a new move's, `fresh`, or a changed one's)."""
         self._set = LawSet.of(laws, self._ends.diff, self.settings.force_tracking_fast_guard)
+        self._integral.adopt(self._set, fresh)
         self._shown = list(self._set.types)
         self.preprocessor.keep_fast = any(self._set.guarded)
         self._watch_floor_update()
@@ -165,7 +165,6 @@ class ContactControl:
         for i, law in enumerate(laws):
             if law.law != old[i] or not law.law:
                 self._v[i] = 0.0
-                self._integral.restart_axis(i)
                 self._moved.restart_axis(i)
                 self._ends.restart_axis(i)
         self._ends.started(t)
@@ -287,10 +286,8 @@ class ContactControl:
                 target = normal_velocity(c.laws[i], turn[i - 3]) + (reference[i] if c.path_axes else 0.0)
             else:
                 target = law_velocity(c.laws[i], tuning[i], w[i], travel[i])
-                if c.integrating[i]:
-                    target += self._integral.step(i, c.laws[i], tuning[i], w[i], dt)
-                if c.guarded[i]:
-                    target = guard_pressing(c.laws[i], tuning[i], target, fast[i])
+                if c.types[i] == Law.FORCE_TRACKING:
+                    target = self._integral.velocity(i, c, tuning[i], target, w[i], fast[i], dt)
             v[i] = shape_velocity(target, v[i], tuning[i], dt, c.floor[i])
 
     def _cycle_dt(self, t: float) -> float:

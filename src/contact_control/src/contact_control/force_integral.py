@@ -16,7 +16,8 @@ correction, never a second approach.
 
 from __future__ import annotations
 
-from contact_control.laws import AxisLaw
+from contact_control.law_set import LawSet
+from contact_control.laws import AxisLaw, guard_pressing
 from contact_control.params import AxisTuning
 
 __all__ = ["ForceIntegral"]
@@ -24,19 +25,26 @@ __all__ = ["ForceIntegral"]
 
 class ForceIntegral:
     """The integral term of each force-tracking axis of a move beside a path law (`LawSet.integrating`);
-    `reset` for a new move."""
+    `adopt` when laws are set."""
 
     def __init__(self) -> None:
         self._term = [0.0] * 6
 
-    def reset(self) -> None:
-        """A new move: every term from zero."""
+    def adopt(self, laws: LawSet, fresh: bool) -> None:
+        """New laws: every term from zero for a new move (`fresh`), else those of the axes that stopped
+        integrating (an axis that keeps force tracking beside a path keeps its term: bumpless)."""
         for i in range(6):
-            self._term[i] = 0.0
+            if fresh or not laws.integrating[i]:
+                self._term[i] = 0.0
 
-    def restart_axis(self, axis: int) -> None:
-        """`axis` changed its law: its term from zero (an axis that keeps force tracking keeps its term)."""
-        self._term[axis] = 0.0
+    def velocity(self, axis: int, laws: LawSet, tuning: AxisTuning, v: float, force: float, fast: float,
+                 dt: float) -> float:
+        """Force tracking's law velocity `v` of `axis` with what the move adds to it: this term beside a path
+        (`step`, the filtered `force`), then the pressing guard on the unfiltered `fast` force."""
+        law = laws.laws[axis]
+        if laws.integrating[axis]:
+            v += self.step(axis, law, tuning, force, dt)
+        return guard_pressing(law, tuning, v, fast) if laws.guarded[axis] else v
 
     def step(self, axis: int, law: AxisLaw, tuning: AxisTuning, force: float, dt: float) -> float:
         """The term's velocity this cycle [m/s or rad/s] for the filtered `force` of `axis`, `dt` [s] since
