@@ -387,7 +387,7 @@ def test_a_five_joint_arm_jogs_and_its_status_names_the_rotation_it_cannot_make(
     from std_msgs.msg import Float64MultiArray
 
     params = {"ee_frame_name": SO100.tip, "planning_frame": SO100.planning_frame, "cmd_frame": "",
-              "command_out_type": "velocity_array", **SO100.params}
+              "command_out_type": "velocity_array", "integrate_from": "measured", **SO100.params}
     status = Collector("/jog_so100/status", JogStatus)
     try:
         with arm_server(ros_node, "jog_so100", "/jog_five", params, Float64MultiArray, SO100) as (commands,

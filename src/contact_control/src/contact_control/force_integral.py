@@ -2,11 +2,12 @@
 
 Force tracking's V = (F - F_target) / b is a proportional law: a surface that moves away from the tool at
 r m/s is followed with the force short of its target by b r. Beside a path law that is the usual case, not
-an exception: sliding along a curved part with the tool's axis a degree off the true normal (a sensor's bias
-of 0.2 N tilts the read normal that much at 10 N) carries the tool off the part at v sin(angle), 0.4 mm/s
-at 20 mm/s, and at b = 2000 the force settles 0.8 N short, less the pressing the fast guard vetoes on the
-raw force's spikes. The integral term adds (1 / (b T_i)) times the force error's integral, so the error
-decays with the time constant T_i instead of staying.
+an exception: sliding along a curved part with the tool's axis a degree off the true normal (a sensor's slow
+drift of 0.2 N, as fitted for the UR e-series' sensor in mujoco_driver's ur_robot_driver profile, tilts the
+read normal that much at 10 N) carries the tool off the part at v sin(angle), 0.4 mm/s at 20 mm/s, and at
+b = 2000 the force settles 0.8 N short, less the pressing the fast guard vetoes on the raw force's spikes.
+The integral term adds (1 / (b T_i)) times the force error's integral, so the error decays with the time
+constant T_i instead of staying.
 
 It integrates the error outside the law's deadband, only in contact (F past the contact fraction of its
 target): out of contact the law approaches at its approach speed and the term restarts from zero, so a
