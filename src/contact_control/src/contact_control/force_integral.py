@@ -18,7 +18,7 @@ correction, never a second approach.
 from __future__ import annotations
 
 from contact_control.law_set import LawSet
-from contact_control.laws import AxisLaw, guard_pressing
+from contact_control.laws import AxisLaw, guard_pressing, short_of_contact
 from contact_control.params import AxisTuning
 
 __all__ = ["ForceIntegral"]
@@ -50,10 +50,8 @@ class ForceIntegral:
     def step(self, axis: int, law: AxisLaw, tuning: AxisTuning, force: float, dt: float) -> float:
         """The term's velocity this cycle [m/s or rad/s] for the filtered `force` of `axis`, `dt` [s] since
         the last cycle (0 while `tuning.track_integral_time` is 0)."""
-        time = tuning.track_integral_time
-        target = law.target
-        edge = tuning.contact_fraction * target
-        if time <= 0.0 or (force > edge if target < 0.0 else force < edge):
+        time, target = tuning.track_integral_time, law.target
+        if time <= 0.0 or short_of_contact(target, tuning.contact_fraction, force):
             self._term[axis] = 0.0
             return 0.0
         error, band = force - target, tuning.track_deadband

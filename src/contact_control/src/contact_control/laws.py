@@ -50,7 +50,7 @@ from contact_control.params import AxisTuning
 
 __all__ = [
     "AxisLaw", "ForceWindow", "check_end", "guard_pressing", "law_velocity", "path_velocity", "round_to",
-    "shape_velocity",
+    "shape_velocity", "short_of_contact",
 ]
 
 
@@ -122,15 +122,17 @@ def law_velocity(law: AxisLaw, tuning: AxisTuning, force: float, travel: float) 
         # Continuous at the band's edge: stepping to band / b there made a relay whose steps, held for the
         # filter's delay against a stiff surface, swung the force by +-2 N (README, *Force tracking*).
         v = (error - math.copysign(band, error)) / law.damping
-        target = law.target
-        # Out of contact (the force short of contact_fraction of the target on the target's side): toward
-        # it at the approach speed, which sets the overshoot on touching; never faster for a small b.
-        if target > 0.0 and force < tuning.contact_fraction * target:
-            return -law.velocity
-        if target < 0.0 and force > tuning.contact_fraction * target:
-            return law.velocity
+        # Out of contact: toward it at the approach speed, which sets the overshoot on touching; never
+        # faster for a small b.
+        if short_of_contact(law.target, tuning.contact_fraction, force):
+            return -law.velocity if law.target > 0.0 else law.velocity
         return v
     return 0.0
+
+
+def short_of_contact(target: float, fraction: float, force: float) -> bool:
+    """Force tracking is out of contact: `force` short of `fraction` of a nonzero `target` on its side."""
+    return force < fraction * target if target > 0.0 else target < 0.0 and force > fraction * target
 
 
 def guard_pressing(law: AxisLaw, tuning: AxisTuning, v: float, fast: float) -> float:
