@@ -60,6 +60,49 @@ def test_the_seeded_offset_is_within_its_spread_and_the_same_for_the_same_seed()
     assert hole_offset(7, 0.004, 0.035) == offsets[7]
 
 
+def _peg_in(hole: Hole, tilted: bool, depth: float) -> bool:
+    """Whether the peg, its tip `depth` down the axis of `hole` (at the level block's top centre) and turned
+    with the hole's tilt (or upright), touches the plate."""
+    block = Box(position=(0.6, 0.1, 0.065), size=(0.15, 0.15, 0.13))
+    spec = mujoco.MjSpec()
+    for box in hole_boxes(block, hole):
+        spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=list(box.half), pos=list(box.pos),
+                                quat=list(box.quat))
+    roll = hole.tilt[0] if tilted else 0.0
+    top = (0.6, 0.1, 0.13 + hole.depth)
+    axis = (0.0, math.sin(hole.tilt[0]), -math.cos(hole.tilt[0]))  # down the hole (a roll only)
+    tip = [top[i] + depth * axis[i] for i in range(3)]
+    up = (0.0, -math.sin(roll), math.cos(roll))
+    peg = spec.worldbody.add_body(pos=[tip[i] + 0.02 * up[i] for i in range(3)],
+                                  quat=[math.cos(roll / 2), math.sin(roll / 2), 0.0, 0.0])
+    peg.add_freejoint()
+    peg.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.005, 0.005, 0.02])
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    return any(data.contact[i].dist < 0.0 for i in range(data.ncon))
+
+
+def test_a_tilted_hole_takes_the_peg_turned_with_it_and_wedges_it_upright():
+    hole = Hole(clearance=0.0001, tilt=(math.radians(3.0), 0.0))
+    assert not _peg_in(hole, tilted=True, depth=0.015)
+    assert _peg_in(hole, tilted=False, depth=0.015)  # 0.1 mm allows 0.4 degrees over 15 mm
+    level = Hole(clearance=0.0001)
+    assert not _peg_in(level, tilted=False, depth=0.015)
+
+
+def test_a_tilt_over_its_limit_is_refused():
+    from mujoco_driver.params import DriverParamError, DriverSettings, load_scene
+
+    scene = {"start_pose": [0.0], "servo": {"kp": 1.0, "kv": 1.0},
+             "obstacle": {"position": [0.5, 0.0, 0.05], "size": [0.1, 0.1, 0.1]}}
+    settings = DriverSettings.from_params({"fixture": "hole", "hole_tilt": [0.05, -0.02], "scene": scene})
+    cfg = load_scene(settings)
+    assert cfg.hole is not None and cfg.hole.tilt == (0.05, -0.02)
+    with pytest.raises(DriverParamError, match="hole_tilt"):
+        load_scene(DriverSettings.from_params({"fixture": "hole", "hole_tilt": [0.0, 0.2], "scene": scene}))
+
+
 def test_a_tilted_block_is_refused():
     with pytest.raises(ValueError, match="level obstacle"):
         hole_boxes(Box(position=(0.0, 0.0, 0.0), size=(0.1, 0.1, 0.1), rpy=(0.1, 0.0, 0.0)), HOLE)

@@ -152,8 +152,9 @@ class Box:
 @dataclass(frozen=True)
 class Hole:
     """A plate with a square, chamfered hole lying on the obstacle block (mujoco_driver.fixtures): the peg's
-    width, the clearance, depth and chamfer [m], the plate's side [m], and the hole's offset from the block's
-    centre (dx, dy [m], yaw [rad]), which a task is not told."""
+    width, the clearance, depth and chamfer [m], the plate's side [m], the hole's offset from the block's
+    centre (dx, dy [m], yaw [rad]) and its tilt about its own x then y axis through the top's centre (roll,
+    pitch [rad]: its axis no longer along the block's normal), which a task is not told."""
 
     peg: float = 0.01
     clearance: float = 0.0004
@@ -161,6 +162,7 @@ class Hole:
     chamfer: float = 0.001
     plate: float = 0.12
     offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    tilt: tuple[float, float] = (0.0, 0.0)
 
 
 @dataclass(frozen=True)

@@ -63,7 +63,9 @@ def hole_boxes(block: Box, hole: Hole) -> list[FixtureBox]:
     """The plate lying on the block's top, its hole at the top's centre moved by `hole.offset`.
 
     The hole's bottom is the block's top; its opening is `peg + clearance` wide and widens by `chamfer` on
-    each side at the top, the 45-degree chamfer made of boxes turned about the edges.
+    each side at the top, the 45-degree chamfer made of boxes turned about the edges. A tilted hole turns the
+    whole plate about the top's centre (its edges then dip into the block or stand above it: static geoms
+    do not collide with each other).
     """
     if any(abs(a) > 1e-9 for a in block.rpy[:2]):
         raise ValueError("the hole fixture needs a level obstacle (rpy roll and pitch 0)")
@@ -80,18 +82,30 @@ def hole_boxes(block: Box, hole: Hole) -> list[FixtureBox]:
             ("hole_chamfer_south", (edge, side, side), (0.0, -edge, -chamfer), "x"),
         ]
     x, y, top, yaw = hole_pose(block, hole)
-    c, s = math.cos(yaw), math.sin(yaw)
     origin = np.array([x, y, top])
-    turn = (math.cos(yaw / 2.0), 0.0, 0.0, math.sin(yaw / 2.0))
+    roll, pitch = hole.tilt
+    # The hole frame: the yaw, then the tilt about its own x and y axes, all through the top's centre.
+    frame = _multiply(_multiply((math.cos(yaw / 2.0), 0.0, 0.0, math.sin(yaw / 2.0)),
+                                (math.cos(roll / 2.0), math.sin(roll / 2.0), 0.0, 0.0)),
+                      (math.cos(pitch / 2.0), 0.0, math.sin(pitch / 2.0), 0.0))
+    turn = _matrix(frame)
     boxes = []
     q = math.cos(math.pi / 8.0), math.sin(math.pi / 8.0)
     for name, half, local, axis in parts:
-        pos = origin + np.array([c * local[0] - s * local[1], s * local[0] + c * local[1], local[2]])
-        quat = turn
-        if axis:  # 45 degrees about the hole frame's x or y axis, then the yaw
-            quat = _multiply(turn, (q[0], q[1], 0.0, 0.0) if axis == "x" else (q[0], 0.0, q[1], 0.0))
+        pos = origin + turn @ np.array(local)
+        quat = frame
+        if axis:  # 45 degrees about the hole frame's x or y axis
+            quat = _multiply(frame, (q[0], q[1], 0.0, 0.0) if axis == "x" else (q[0], 0.0, q[1], 0.0))
         boxes.append(FixtureBox(name, half, (float(pos[0]), float(pos[1]), float(pos[2])), quat))
     return boxes
+
+
+def _matrix(q: tuple[float, float, float, float]) -> np.ndarray:
+    """The rotation matrix of a unit quaternion (w, x, y, z)."""
+    w, x, y, z = q
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
 def _multiply(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, float, float, float]:

@@ -112,6 +112,11 @@ class DriverSettings:
     hole_seed: int = param(
         -1, ge=-1, doc=">= 0: the offset drawn from this seed instead (within 4 mm and 2 degrees of nominal)"
     )
+    hole_tilt: tuple[float, ...] = param(
+        (0.0, 0.0), type="floats", length=2, unit="rad, rad",
+        doc="the hole's axis tilted about its own x, then y axis through the plate top's centre (roll, "
+        "pitch; at most 0.1 rad), which a task is not told",
+    )
     hole_clearance: float = param(0.0004, unit="m", gt=0.0, le=0.01, doc="hole width minus the peg's")
     hole_chamfer: float = param(0.001, unit="m", ge=0.0, le=0.005,
                                 doc="the hole's 45-degree chamfer (0: none)")
@@ -253,6 +258,7 @@ def urdf_root_link(urdf_xml: str) -> str:
 # contact_tasks' peg_in_hole demonstration: the hole within 4 mm and 2 degrees of its nominal pose (#35).
 HOLE_SPREAD = 0.004  # [m]
 HOLE_YAW_SPREAD = 0.035  # [rad]
+HOLE_TILT_MAX = 0.1  # [rad] the 120 mm plate's edge then 6 mm off the block's top
 
 
 # The finishing fixtures (#37): each kind's default radius [m] and how far its place is from nominal.
@@ -301,8 +307,12 @@ def load_scene(settings: DriverSettings) -> SceneConfig:
         offset = tuple(settings.hole_offset)
         if settings.hole_seed >= 0:
             offset = hole_offset(settings.hole_seed, HOLE_SPREAD, HOLE_YAW_SPREAD)
+        if any(abs(a) > HOLE_TILT_MAX for a in settings.hole_tilt):
+            raise DriverParamError(f"~hole_tilt {list(settings.hole_tilt)}: each angle at most "
+                                   f"{HOLE_TILT_MAX} rad (the plate would leave the block)")
         hole = Hole(peg=settings.peg_width, clearance=settings.hole_clearance, depth=settings.hole_depth,
-                    chamfer=settings.hole_chamfer, offset=offset)  # type: ignore[arg-type]
+                    chamfer=settings.hole_chamfer, offset=offset,  # type: ignore[arg-type]
+                    tilt=tuple(settings.hole_tilt))  # type: ignore[arg-type]
         cfg = dataclasses.replace(cfg, hole=hole)
     if settings.fixture in SURFACE_RADIUS:
         cfg = _with_surface(cfg, settings)

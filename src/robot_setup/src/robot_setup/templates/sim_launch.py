@@ -33,6 +33,7 @@ def sim_launch(plan: Plan) -> str:
   <arg name="fixture" default="none" doc="clear: no block; hole: a plate with a square, chamfered hole on the block; hand: a person's hand (ISO/TS 15066) lying on it; tilted: the block's top tilted 15 degrees; cylinder, sphere: a curved part in the block's place (mujoco_driver README, Fixtures)"/>
   <arg name="hole_offset" default="[0.0, 0.0, 0.0]" doc="the hole's offset from its nominal pose '[dx, dy, yaw]' [m, m, rad]"/>
   <arg name="hole_seed" default="-1" doc="&gt;= 0: the hole's offset drawn from this seed instead (within 4 mm and 2 degrees)"/>
+  <arg name="hole_tilt" default="[0.0, 0.0]" doc="the hole's axis tilted '[roll, pitch]' [rad] about its own x, then y axis (at most 0.1)"/>
   <arg name="surface_seed" default="-1" doc="&gt;= 0: the tilted, cylinder or sphere fixture's offset drawn from this seed (each of dx, dy, dz within 10 mm)"/>
   <arg name="surface_offset" default="[0.0, 0.0, 0.0]" doc="the tilted, cylinder or sphere fixture's offset from its nominal place '[dx, dy, dz]' [m]"/>
   <arg name="hole_clearance" default="0.0004" doc="[m] the hole's width minus the peg's"/>
@@ -58,6 +59,7 @@ def sim_launch(plan: Plan) -> str:
     <arg name="fixture" value="$(arg fixture)"/>
     <arg name="hole_offset" value="$(arg hole_offset)"/>
     <arg name="hole_seed" value="$(arg hole_seed)"/>
+    <arg name="hole_tilt" value="$(arg hole_tilt)"/>
     <arg name="surface_seed" value="$(arg surface_seed)"/>
     <arg name="surface_offset" value="$(arg surface_offset)"/>
     <arg name="hole_clearance" value="$(arg hole_clearance)"/>
