@@ -17,22 +17,27 @@ TOP = 0.13 + HOLE.depth  # the plate's top [m]
 YAW = 0.3 + 0.02
 
 
-def touches(x: float, y: float, bottom: float) -> bool:
-    """Whether the peg (10 mm square, 40 mm long, turned like the hole) with its bottom face at `bottom`,
-    centred at (x, y) in the hole's own axes from its centre, touches the fixture."""
+def _peg_touches(block: Box, hole: Hole, centre: list[float], quat: list[float]) -> bool:
+    """Whether the peg (10 mm square, 40 mm long) with its centre and orientation there touches the plate."""
     spec = mujoco.MjSpec()
-    for box in hole_boxes(BLOCK, HOLE):
+    for box in hole_boxes(block, hole):
         spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=list(box.half), pos=list(box.pos),
                                 quat=list(box.quat))
-    c, s = math.cos(YAW), math.sin(YAW)
-    centre = (0.6 + 0.003 + c * x - s * y, 0.1 - 0.002 + s * x + c * y, bottom + 0.02)
-    peg = spec.worldbody.add_body(pos=list(centre), quat=[math.cos(YAW / 2), 0.0, 0.0, math.sin(YAW / 2)])
+    peg = spec.worldbody.add_body(pos=centre, quat=quat)
     peg.add_freejoint()
     peg.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.005, 0.005, 0.02])
     model = spec.compile()
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     return any(data.contact[i].dist < 0.0 for i in range(data.ncon))
+
+
+def touches(x: float, y: float, bottom: float) -> bool:
+    """Whether the peg, turned like the hole, with its bottom face at `bottom`, centred at (x, y) in the
+    hole's own axes from its centre, touches the fixture."""
+    c, s = math.cos(YAW), math.sin(YAW)
+    centre = [0.6 + 0.003 + c * x - s * y, 0.1 - 0.002 + s * x + c * y, bottom + 0.02]
+    return _peg_touches(BLOCK, HOLE, centre, [math.cos(YAW / 2), 0.0, 0.0, math.sin(YAW / 2)])
 
 
 def test_the_peg_fits_the_hole_within_its_clearance_and_touches_a_wall_beyond_it():
@@ -63,24 +68,13 @@ def test_the_seeded_offset_is_within_its_spread_and_the_same_for_the_same_seed()
 def _peg_in(hole: Hole, tilted: bool, depth: float) -> bool:
     """Whether the peg, its tip `depth` down the axis of `hole` (at the level block's top centre) and turned
     with the hole's tilt (or upright), touches the plate."""
-    block = Box(position=(0.6, 0.1, 0.065), size=(0.15, 0.15, 0.13))
-    spec = mujoco.MjSpec()
-    for box in hole_boxes(block, hole):
-        spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=list(box.half), pos=list(box.pos),
-                                quat=list(box.quat))
     roll = hole.tilt[0] if tilted else 0.0
     top = (0.6, 0.1, 0.13 + hole.depth)
     axis = (0.0, math.sin(hole.tilt[0]), -math.cos(hole.tilt[0]))  # down the hole (a roll only)
-    tip = [top[i] + depth * axis[i] for i in range(3)]
     up = (0.0, -math.sin(roll), math.cos(roll))
-    peg = spec.worldbody.add_body(pos=[tip[i] + 0.02 * up[i] for i in range(3)],
-                                  quat=[math.cos(roll / 2), math.sin(roll / 2), 0.0, 0.0])
-    peg.add_freejoint()
-    peg.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.005, 0.005, 0.02])
-    model = spec.compile()
-    data = mujoco.MjData(model)
-    mujoco.mj_forward(model, data)
-    return any(data.contact[i].dist < 0.0 for i in range(data.ncon))
+    centre = [top[i] + depth * axis[i] + 0.02 * up[i] for i in range(3)]
+    block = Box(position=(0.6, 0.1, 0.065), size=(0.15, 0.15, 0.13))
+    return _peg_touches(block, hole, centre, [math.cos(roll / 2), math.sin(roll / 2), 0.0, 0.0])
 
 
 def test_a_tilted_hole_takes_the_peg_turned_with_it_and_wedges_it_upright():
