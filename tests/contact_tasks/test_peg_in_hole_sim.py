@@ -23,14 +23,14 @@ SURFACE = 0.05  # the start pose's tool tip (z 0.20) above the plate
 
 
 def insert(rospy, offset: tuple[float, float, float], clearance: float = 0.0004,
-           tilt: tuple[float, float] = (0.0, 0.0), overrides: str = ""):
+           tilt: tuple[float, float] = (0.0, 0.0)):
     """The task's result, the tool (x, y, z, yaw) where it ended and the yaw it started with."""
     args = {"fixture": "hole", "tool": "peg", "hole_offset": f"[{offset[0]}, {offset[1]}, {offset[2]}]",
             "hole_clearance": clearance, "hole_tilt": f"[{tilt[0]}, {tilt[1]}]"}
     with task_stack(args) as (h, client, tool):
         assert rospy.ServiceProxy("/named_poses/move_to", MoveToNamedPose)(name="start").success
         start_yaw = tool()[3]
-        client.send_goal(ExecuteTaskGoal(task="peg_in_hole", overrides=f"{{surface: {SURFACE}{overrides}}}"))
+        client.send_goal(ExecuteTaskGoal(task="peg_in_hole", overrides=f"{{surface: {SURFACE}}}"))
         assert client.wait_for_result(rospy.Duration(120.0))
         result = client.get_result()
         tip = tool()
@@ -72,4 +72,3 @@ def test_a_hole_whose_axis_is_tilted_3_degrees_goes_in_as_the_peg_tilts_about_it
     assert result.steps[-1] == "insert"
     assert result.peak_force <= 25.0 and result.peak_torque <= 0.2
     assert sum(result.step_times) < 45.0
-
