@@ -1,4 +1,4 @@
-"""/diagnostics (issue #23): the health reports' levels (pure), and on an emulated UR cell every node of ours
+"""/diagnostics: the health reports' levels (pure), and on an emulated UR cell every node of ours
 reporting, contact_control OK while the sensor is fresh and ERROR with the reason within 1 s of stopping the
 driver, as `rosrun compliant_common show_diagnostics` prints it."""
 

@@ -1,5 +1,5 @@
 """No `Any` in the public signatures of compliant_common, contact_control, jog_arm and control_stack
-(issue #21, with mypy's strict flags for those packages in mypy.ini). Public: a function or method whose
+(with mypy's strict flags for those packages in mypy.ini). Public: a function or method whose
 name has no leading underscore (dunders such as __init__ count: they are the class's public face), in a
 module and classes whose names have none either. Private helpers may keep Any."""
 

@@ -1,4 +1,4 @@
-"""Live tuning (issue #23): `dynparam set /contact_control_node max_velocity 0.05` while the hand-guided tool
+"""Live tuning: `dynparam set /contact_control_node max_velocity 0.05` while the hand-guided tool
 moves at 0.2 m/s slows it to 0.05 m/s within the deceleration limit (no step); a bad value is refused with
 the reason on ~status and changes nothing."""
 

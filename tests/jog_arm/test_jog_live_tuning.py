@@ -1,4 +1,4 @@
-"""Live tuning of jog_arm (issue #23): `dynparam set /jog_arm_server scale/linear 0.2` doubles the speed of a
+"""Live tuning of jog_arm: `dynparam set /jog_arm_server scale/linear 0.2` doubles the speed of a
 streamed unitless twist without a step beyond the joint acceleration limits; values the start-up checks
 refuse (out of range, or against another parameter) are refused and change nothing."""
 

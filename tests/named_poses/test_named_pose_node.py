@@ -96,8 +96,8 @@ def test_refused_while_a_contact_move_runs(stack):
 
 def test_a_fresh_named_poses_node_refuses_during_a_contact_move_it_has_not_heard_of_yet(stack):
     """Asked right after start-up, before its status subscription has delivered anything, named_poses waits
-    for contact_control's status instead of taking silence for "no contact move" (issue #21: the test above
-    passed only after others had warmed the connection)."""
+    for contact_control's status instead of taking silence for "no contact move" (the test above
+    would otherwise pass only after others had warmed the connection)."""
     import rospy
     from compliant_control_msgs.msg import ContactControlStatus
     from compliant_control_msgs.srv import MoveToNamedPose

@@ -1,4 +1,4 @@
-"""Type aliases shared by the stack's packages (issue #21: no `Any` in their public signatures)."""
+"""Type aliases shared by the stack's packages (no `Any` in their public signatures)."""
 
 from __future__ import annotations
 

@@ -48,8 +48,7 @@ class ContactControl:
         self.intake = WrenchIntake(s, self.notes, on_floor=self._watch_floor_update)
         self.preprocessor = self.intake.preprocessor
         self._tuning = tuple(s.tuning(i >= 3) for i in range(6))
-        self._end_timeout = s.no_data_end_timeout
-        self._dt_nominal = 1.0 / s.control_rate
+        self._end_timeout, self._dt_nominal = s.no_data_end_timeout, 1.0 / s.control_rate
         self._ends = EndChecks(tuple(t.diff_max for t in self._tuning), s.diff_window, s.force_limit_arm_time,
                                int(s.force_limit_samples))
         self._moved = MoveTravel(s.travel_directions)
@@ -310,10 +309,8 @@ class ContactControl:
         return None
 
     def check_stale(self, t: float) -> CycleResult | None:
-        """Timer check: None while wrenches are fresh, else a zero-output result (Safety.STALE).
-
-        Ends the move with NO_FT_DATA once data has been missing for `no_data_end_timeout`.
-        """
+        """Timer check: None while wrenches are fresh, else a zero-output result (Safety.STALE); ends the
+        move with NO_FT_DATA once data has been missing for `no_data_end_timeout`."""
         last, timeout, move = self.intake.last_wrench_time, self.intake.wrench_timeout, self._move
         if last is not None and t - last <= timeout:
             return None
@@ -359,10 +356,10 @@ class ContactControl:
             self._watch.set_floor(self._tuning, self._set.laws, self.intake.noise_floor)
 
     def _end_and_hold(self, t: float, axis: int, condition: int) -> CycleResult:
-        path = self._path
         why = end_reason(axis, condition, self._set.laws[axis], force=self._wrench[axis],
                          travel=self._moved.values[axis], path_error=self._path_error[axis],
-                         path_age=path.age(t), path_timeout=path.timeout, diff=self._ends.diff[axis])
+                         path_age=self._path.age(t), path_timeout=self._path.timeout,
+                         diff=self._ends.diff[axis])
         kept = self._v
         self._end_move(axis, condition, True, why)
         if condition == End.FT_VIOLATION and self._reaction.start(self._set.laws, self._wrench):
@@ -397,7 +394,6 @@ class ContactControl:
             self._wrench = w  # ~status and the events show the wrench that tripped
         self._reaction.clear()  # nothing moves after a safety trip, whatever the exceeded action said
         self._v = [0.0] * 6
-        p = self.preprocessor
-        self._move.latch(self._global.message(w, p.max_force, p.max_torque))
+        self._move.latch(self._global.message(w, self.preprocessor.max_force, self.preprocessor.max_torque))
         if self._move.active:
             self._end_move(-1, End.FT_VIOLATION, False, self._move.latch_message)

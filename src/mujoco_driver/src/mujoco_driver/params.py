@@ -255,13 +255,13 @@ def urdf_root_link(urdf_xml: str) -> str:
     return str(roots[0])
 
 
-# contact_tasks' peg_in_hole demonstration: the hole within 4 mm and 2 degrees of its nominal pose (#35).
+# contact_tasks' peg_in_hole demonstration: the hole within 4 mm and 2 degrees of its nominal pose.
 HOLE_SPREAD = 0.004  # [m]
 HOLE_YAW_SPREAD = 0.035  # [rad]
 HOLE_TILT_MAX = 0.1  # [rad] the 120 mm plate's edge then 6 mm off the block's top
 
 
-# The finishing fixtures (#37): each kind's default radius [m] and how far its place is from nominal.
+# The finishing fixtures: each kind's default radius [m] and how far its place is from nominal.
 SURFACE_RADIUS = {"tilted": 0.0, "cylinder": 0.25, "sphere": 0.3}
 SURFACE_SPREAD = 0.01  # [m] each of dx, dy, dz with surface_seed
 

@@ -284,7 +284,7 @@ def surface_following() -> Scenario:
     )
 
 
-# Teach and replay (the sixth demonstration, issue #22): the simulated human guides the tool along an L (10 cm
+# Teach and replay (the sixth demonstration): the simulated human guides the tool along an L (10 cm
 # along X, then 5 cm along Y, scaled to the block by geometry.fit_l) with hand-guiding on while teach's
 # program_server records it; the program is replayed in free space at its speed and at twice it, then pressing
 # on the block with Z force tracking at SURFACE_TARGET_FORCE.
