@@ -68,6 +68,18 @@ def test_pacer_drops_a_backlog_longer_than_max_lag():
     assert pacer.wait_time(1.0) == pytest.approx(0.002)
 
 
+def test_a_pacer_without_catch_up_slows_the_simulation_instead_of_stepping_ahead():
+    """Simulated time: a late step is due at once, the next one a full period after it (no burst, no
+    skipped publication), and nothing counts as dropped."""
+    pacer = Pacer(dt=0.002, real_time_factor=3.0, catch_up=False)
+    pacer.start(0.0)
+    pacer.step_done()
+    assert pacer.wait_time(0.0105) == 0.0  # 10 ms late
+    pacer.step_done()
+    assert pacer.wait_time(0.0105) == pytest.approx(0.002 / 3.0)
+    assert pacer.lag(0.0105) == 0.0 and pacer.dropped == 0.0
+
+
 @pytest.mark.parametrize("factor, period", [(2.0, 0.001), (0.5, 0.004), (0.0, 0.0)])
 def test_pacer_period_follows_the_real_time_factor(factor, period):
     pacer = Pacer(dt=0.002, real_time_factor=factor)

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from harness.bags import read_bag
 from harness.launch import process_slot
+from harness.sim_clock import FAST
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
@@ -20,9 +21,10 @@ def _run(command: list[str], **kwargs) -> subprocess.CompletedProcess:
         return subprocess.run(command, **kwargs)
 
 
-def _demo(*args: str) -> list[str]:
-    """`make demo`'s command line with these arguments."""
-    return [str(ROOT / "scripts/with_env"), "python", str(ROOT / "scripts/demo"), *args]
+def _demo(*args: str, fast: bool = True) -> list[str]:
+    """`make demo`'s command line with these arguments; `fast`: simulated time at harness.sim_clock.FAST."""
+    rate = ["--real-time-factor", str(FAST)] if fast else []
+    return [str(ROOT / "scripts/with_env"), "python", str(ROOT / "scripts/demo"), *rate, *args]
 
 
 @pytest.mark.e2e  # scripts/demo runs the simulation
@@ -75,7 +77,8 @@ def test_driver_options_without_a_driver_are_refused_before_anything_launches(tm
 
 
 # Alone (after the parallel suite): beside another worker's simulations the UR3's pressed replay left
-# 10 +- 1.5 N (50 ms means 8.15..11.78 N, docs/measurements.md); the timing cause is not found yet (#36).
+# 10 +- 1.5 N (50 ms means 8.15..11.78 N, docs/measurements.md), and so did simulated time at 2 x (7.63 N):
+# the replay's reference stream is not in the driver's lockstep. Real time, alone, until it is.
 @pytest.mark.alone
 def test_teach_and_replay_on_a_generated_arm(tmp_path):
     """The sixth demonstration as `make demo ROBOT=ur3` runs it: the L taught by the simulated hand is
@@ -84,7 +87,8 @@ def test_teach_and_replay_on_a_generated_arm(tmp_path):
     import os
 
     home = tmp_path / "home"
-    command = _demo("--robot", "ur3", "--only", "teach_and_replay", "--output", str(tmp_path / "out"))
+    command = _demo("--robot", "ur3", "--only", "teach_and_replay", "--output", str(tmp_path / "out"),
+                    fast=False)
     run = _run(command, capture_output=True, text=True, timeout=300, check=False,
                env={**os.environ, "HOME": str(home)})
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]

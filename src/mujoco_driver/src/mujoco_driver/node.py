@@ -151,7 +151,8 @@ class MujocoDriverNode:
     def run(self) -> None:
         """Step and publish until :meth:`stop` or a ROS shutdown."""
         s, stepper, ports = self._s, self._stepper, self._ports
-        pacer = Pacer(stepper.dt, s.real_time_factor, s.max_lag)
+        # On simulated time a late step slows the simulation rather than skipping states (README, How it runs)
+        pacer = Pacer(stepper.dt, s.real_time_factor, s.max_lag, catch_up=not s.publish_clock)
         catch_up_lag = max(pacer.period, _CATCH_UP_LAG)
         meter = RtfMeter(s.rtf_period)
         countdowns: list[float] = [0.0] * len(ports)

@@ -5,7 +5,9 @@ The loop asks :meth:`Pacer.wait_time` how long to sleep before the next step is 
 skips publishing the intermediate states). Steps are scheduled on a fixed wall-clock grid (one step every
 ``dt / real_time_factor`` seconds), so a late step is followed by the next ones at once, without sleeping,
 until the simulation has caught up; a backlog longer than ``max_lag`` is dropped instead (the simulation
-then runs behind the wall clock for good, and :attr:`Pacer.dropped` counts the lost time).
+then runs behind the wall clock for good, and :attr:`Pacer.dropped` counts the lost time). Without
+``catch_up`` (simulated time: nothing waits on the wall clock) a late step restarts the grid: the simulation
+slows down instead of stepping ahead unpublished.
 """
 
 from __future__ import annotations
@@ -22,12 +24,14 @@ class Pacer:
         dt: Simulation timestep [s].
         real_time_factor: Simulated seconds per wall-clock second; 0 runs as fast as possible.
         max_lag: Largest backlog [s of wall time] caught up by stepping without sleeping; more is dropped.
+        catch_up: False: no backlog is kept (a late step is due now, the next a period later).
 
     Raises:
         ValueError: On a non-positive ``dt`` or ``max_lag``, or a negative or non-finite factor.
     """
 
-    def __init__(self, dt: float, real_time_factor: float = 1.0, max_lag: float = 0.1) -> None:
+    def __init__(self, dt: float, real_time_factor: float = 1.0, max_lag: float = 0.1,
+                 catch_up: bool = True) -> None:
         if not (math.isfinite(dt) and dt > 0.0):
             raise ValueError(f"dt must be > 0, got {dt}")
         if not (math.isfinite(real_time_factor) and real_time_factor >= 0.0):
@@ -36,6 +40,7 @@ class Pacer:
             raise ValueError(f"max_lag must be > 0, got {max_lag}")
         self.period = dt / real_time_factor if real_time_factor > 0.0 else 0.0
         self.max_lag = max_lag
+        self.catch_up = catch_up
         self.dropped = 0.0  # wall time given up to the backlog limit [s]
         self._next = math.nan
 
@@ -50,6 +55,9 @@ class Pacer:
         if self.period == 0.0:
             return 0.0
         ahead = self._next - now
+        if ahead < 0.0 and not self.catch_up:
+            self._next = now
+            return 0.0
         if ahead < -self.max_lag:
             self.dropped -= ahead
             self._next = now

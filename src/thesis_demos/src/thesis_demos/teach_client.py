@@ -108,12 +108,12 @@ class TeachFlow:
         answer = self.r.push(request)
         if not answer.success:
             raise RuntimeError(f"the driver refused the push: {answer.message}")
-        deadline = time.monotonic() + 20.0
-        previous, previous_t = self._tip(), time.monotonic()
+        deadline = time.monotonic() + 20.0  # a hang guard; the speed is measured in ROS time (simulated)
+        previous, previous_t = self._tip(), self.r.now()
         speed = 0.0
         while time.monotonic() < deadline:
-            time.sleep(0.01)
-            tip, now = self._tip(), time.monotonic()
+            rospy.sleep(0.01)
+            tip, now = self._tip(), self.r.now()
             speed = 0.7 * speed + 0.3 * abs(tip[axis] - previous[axis]) / max(now - previous_t, 1e-3)
             previous, previous_t = tip, now
             if abs(tip[axis] - start[axis]) >= abs(leg) - speed * COAST_TIME:
