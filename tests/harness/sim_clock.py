@@ -2,8 +2,8 @@
 
 The session's client node starts on the wall clock (one rospy node per process). A stack launched with
 `sim_time:=true` publishes /clock; inside `sim_clock()` this process's rospy time follows it, so a client
-(the demonstration runner, a test's waits) measures the simulation's seconds however fast it runs, and the
-wall clock comes back on exit.
+(the demonstration runner, a test's waits) measures the simulation's seconds however fast it runs; on exit the
+wall clock comes back and /use_sim_time is deleted (the launch's nodes have read it already).
 """
 
 from __future__ import annotations
@@ -47,3 +47,7 @@ def sim_clock(timeout: float = 60.0) -> Iterator[None]:
     finally:
         sub.unregister()
         rospy.rostime.switch_to_wallclock()
+        # The launch set /use_sim_time true on the session's master; a node of a later test would read it at
+        # its start and wait for a /clock that no longer comes.
+        if rospy.has_param("/use_sim_time"):
+            rospy.delete_param("/use_sim_time")

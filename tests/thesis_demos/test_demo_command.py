@@ -21,7 +21,7 @@ def _run(command: list[str], **kwargs) -> subprocess.CompletedProcess:
         return subprocess.run(command, **kwargs)
 
 
-def _demo(*args: str, fast: bool = True) -> list[str]:
+def _demo(*args: str, fast: bool = False) -> list[str]:
     """`make demo`'s command line with these arguments; `fast`: simulated time at harness.sim_clock.FAST."""
     rate = ["--real-time-factor", str(FAST)] if fast else []
     return [str(ROOT / "scripts/with_env"), "python", str(ROOT / "scripts/demo"), *rate, *args]
@@ -87,8 +87,7 @@ def test_teach_and_replay_on_a_generated_arm(tmp_path):
     import os
 
     home = tmp_path / "home"
-    command = _demo("--robot", "ur3", "--only", "teach_and_replay", "--output", str(tmp_path / "out"),
-                    fast=False)
+    command = _demo("--robot", "ur3", "--only", "teach_and_replay", "--output", str(tmp_path / "out"))
     run = _run(command, capture_output=True, text=True, timeout=300, check=False,
                env={**os.environ, "HOME": str(home)})
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
@@ -109,7 +108,7 @@ def test_teach_and_replay_on_a_generated_arm(tmp_path):
 def test_the_curved_surface_runs_in_its_own_scene_and_keeps_the_tool_normal(tmp_path):
     """The eighth demonstration: make demo relaunches the UR5 over the seeded cylinder with the ball-end tool;
     the 0.3 m path planned on the nominal cylinder is run at 10 N with the tool on the real normal."""
-    command = _demo("--robot", "ur5", "--only", "curved_surface", "--output", str(tmp_path))
+    command = _demo("--robot", "ur5", "--only", "curved_surface", "--output", str(tmp_path), fast=True)
     run = _run(command, capture_output=True, text=True, timeout=300, check=False)
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
     line = next(x for x in run.stdout.splitlines() if x.startswith("[PASS] curved_surface"))
