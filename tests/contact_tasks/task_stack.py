@@ -1,4 +1,4 @@
-"""The simulated UR5 with task_server for the end-to-end task tests, on simulated time (harness.sim_clock)."""
+"""The simulated UR5 with task_server, for the end-to-end task tests."""
 
 from __future__ import annotations
 
@@ -12,7 +12,6 @@ import rospy
 import tf2_ros
 from compliant_control_msgs.msg import ExecuteTaskAction
 from harness.launch import Launched, run_launch
-from harness.sim_clock import fast_args, sim_clock
 from harness.waiting import wait_until
 
 
@@ -21,7 +20,7 @@ def task_stack(args: dict | None = None) -> Iterator[tuple[Launched, actionlib.S
                                                            Callable[[], np.ndarray]]]:
     """ur5_custom's sim.launch with `args`: the launch, task_server's ExecuteTask client and the tool tip's
     position and yaw in base_link (tf): x, y, z [m], yaw [rad]."""
-    with run_launch("ur5_custom", "sim.launch", fast_args(**(args or {}))) as h, sim_clock():
+    with run_launch("ur5_custom", "sim.launch", args or {}) as h:
         h.wait_for_service("/named_poses/move_to", timeout=40)
         client = actionlib.SimpleActionClient("/task_server/execute", ExecuteTaskAction)
         assert client.wait_for_server(rospy.Duration(30.0))
