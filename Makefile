@@ -50,7 +50,7 @@ demo: build
 	@$(if $(CELL),$(ENV) python scripts/demo_cell --cell "$(CELL)",$(ENV) python scripts/demo --robot $(ROBOT) \
 		$(if $(DRIVER),--driver $(DRIVER)) $(if $(DRIVER_OPTIONS),--driver-options "$(DRIVER_OPTIONS)") \
 		$(if $(HARDWARE_ARGS),--hardware-args "$(HARDWARE_ARGS)") $(if $(BAG),--bag) \
-		$(if $(MASTER),--master "$(MASTER)") $(if $(RTF),--real-time-factor $(RTF)))
+		$(if $(MASTER),--master "$(MASTER)"))
 
 # make robot NAME=<name> URDF=<path, or relative to example-robot-data's robots/> TIP=<flange link>
 #   [BASE=<link>] [TOOL_MASS=<kg>] [TOOL_RPY=<roll,pitch,yaw>] [HELD=<joint=position,...>]

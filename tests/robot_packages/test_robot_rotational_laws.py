@@ -15,7 +15,6 @@ from compliant_control_msgs.msg import ContactControlStatus
 from compliant_control_msgs.srv import ConfigureLaws, ConfigureLawsRequest, PushEEF, PushEEFRequest
 from geometry_msgs.msg import PoseStamped
 from harness.launch import run_launch
-from harness.sim_clock import fast_args, sim_clock
 from harness.waiting import Collector, wait_until
 from std_srvs.srv import Trigger
 
@@ -43,7 +42,7 @@ def _yaw(R0: np.ndarray, msg: PoseStamped) -> float:
 @pytest.fixture(scope="module", params=["ur5_custom", "panda_custom"])
 def stack(request, ros_node):
     rospy = ros_node
-    with run_launch(request.param, "sim.launch", fast_args()) as h, sim_clock():
+    with run_launch(request.param, "sim.launch") as h:
         h.wait_for_topic("/mujoco_driver/eef_pose", timeout=60)
         h.wait_for_service("/configure_laws", timeout=60)
         h.wait_for_service("/mujoco_driver/push", timeout=60)
