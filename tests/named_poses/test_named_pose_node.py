@@ -97,7 +97,7 @@ def test_refused_while_a_contact_move_runs(stack):
 def test_a_fresh_named_poses_node_refuses_during_a_contact_move_it_has_not_heard_of_yet(stack):
     """Asked right after start-up, before its status subscription has delivered anything, named_poses waits
     for contact_control's status instead of taking silence for "no contact move" (the test above
-    would otherwise pass only after others had warmed the connection)."""
+    cannot see this: by its request the status has arrived)."""
     import rospy
     from compliant_control_msgs.msg import ContactControlStatus
     from compliant_control_msgs.srv import MoveToNamedPose

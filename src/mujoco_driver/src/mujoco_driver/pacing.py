@@ -65,8 +65,9 @@ class Pacer:
         return max(ahead, 0.0)
 
     def lag(self, now: float) -> float:
-        """How far the next step is overdue [s] (0 when on time, ahead, or running as fast as possible)."""
-        if self.period == 0.0 or math.isnan(self._next):
+        """How far the next step is overdue [s] (0 when on time, ahead, running as fast as possible, or
+        without catch-up: nothing is ever owed then)."""
+        if self.period == 0.0 or not self.catch_up or math.isnan(self._next):
             return 0.0
         return max(now - self._next, 0.0)
 

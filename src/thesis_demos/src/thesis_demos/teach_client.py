@@ -112,7 +112,7 @@ class TeachFlow:
         previous, previous_t = self._tip(), self.r.now()
         speed = 0.0
         while time.monotonic() < deadline:
-            rospy.sleep(0.01)
+            time.sleep(0.01)  # polling (a ROS sleep would hang on a stopped simulated clock)
             tip, now = self._tip(), self.r.now()
             speed = 0.7 * speed + 0.3 * abs(tip[axis] - previous[axis]) / max(now - previous_t, 1e-3)
             previous, previous_t = tip, now
