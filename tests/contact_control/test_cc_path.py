@@ -168,6 +168,26 @@ def test_the_move_ends_when_the_reference_stops_coming_or_the_error_grows_too_la
     assert "from the path reached max_travel 0.005" in ctrl.end_message
 
 
+def test_a_move_set_before_its_first_reference_stands_still_for_the_timeout_then_follows_or_ends():
+    """A sender publishes its first reference and then calls ConfigureLaws; the topic may deliver it after
+    the call (or connect a moment later): the move waits for it, standing still, instead of ending."""
+    ctrl = controller(lp_filter_enabled=False, path_reference_timeout=0.3)
+    loop = ClosedLoop(ctrl)
+    loop.start(path())
+    result = loop.run((0.0,) * 6, 0.2)  # nothing yet: the tool holds still
+    assert result.move_active and np.allclose(loop.pose[:3, 3], 0.0, atol=1e-9)
+    t0 = loop.t
+    result = loop.run(feed(loop, 0.0, t0), 1.0)
+    assert result.move_active and loop.pose[0, 3] == pytest.approx(SPEED * (loop.t - t0), abs=1e-3)
+
+    ctrl = controller(lp_filter_enabled=False, path_reference_timeout=0.3)
+    loop = ClosedLoop(ctrl)
+    loop.start(path())
+    result = loop.run((0.0,) * 6, 0.5)  # none within the timeout: lost
+    assert not result.move_active and result.end_conditions[0] == END_PATH_LOST
+    assert "no ~path_reference received" in ctrl.end_message
+
+
 def test_orientation_error_is_a_rotation_vector_along_the_control_axes():
     ctrl = controller(lp_filter_enabled=False)
     pose = np.eye(4)

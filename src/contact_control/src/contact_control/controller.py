@@ -142,6 +142,7 @@ class ContactControl:
         self._v = [0.0] * 6
         self._normal.reset()
         self._moved.restart(eef_pose, R_fixed_control)
+        self._path.begin(t)
         self._last_t = None
         return self._move.begin(bool(self._set.active), t)
 
@@ -167,6 +168,8 @@ class ContactControl:
                 self._moved.restart_axis(i)
                 self._ends.restart_axis(i)
         self._ends.started(t)
+        if any(law.law == Law.PATH and law.law != old[i] for i, law in enumerate(laws)):
+            self._path.begin(t)
         self._adopt(laws)
         return self._move.change()
 

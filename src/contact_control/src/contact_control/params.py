@@ -304,7 +304,8 @@ class ContactControlSettings:
     # path law (ConfigureLaws PATH, fed by ~path_reference)
     path_reference_timeout: float = _pos(
         0.5, "s", "a path law's move ends (PATH_LOST) when no ~path_reference came for this long (the tool "
-        "stands still after `path_extrapolate`; a loaded 2-core machine stalled a replay's stream 0.26 s)"
+        "stands still after `path_extrapolate`; a loaded 2-core machine stalled a replay's stream 0.26 s); a "
+        "move set before its first reference waits this long for it, standing still"
     )
     path_extrapolate: float = _nonneg(
         0.05, "s", "a reference's position moves on with its velocity for at most this long after it came"

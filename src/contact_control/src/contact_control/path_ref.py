@@ -6,8 +6,10 @@ end effector: position [m], rotation vector [rad]) and v_ref, both along the con
 held for `timeout` after its stamp: for `extrapolate` s its position moves on with its velocity; then, if it
 came with a horizon (where it will be every `step` s after), it follows the horizon to its end, and then it
 stands still (no velocity fed forward); an older one is lost, and the move ends (the replay stopped
-sending). A horizon lets a late sender (a stalled replay) keep the tool on its path instead of stopping it
-(teach's README, *Replay*). No ROS here.
+sending). A move that starts before its stream's first reference has arrived (the sender's topic connects a
+moment after its first message, or the message is still on its way behind the ConfigureLaws call) stands
+still for up to `timeout` waiting for it. A horizon lets a late sender (a stalled replay) keep the tool on
+its path instead of stopping it (teach's README, *Replay*). No ROS here.
 """
 
 from __future__ import annotations
@@ -44,6 +46,7 @@ class PathReference:
         self._step = 0.0
         self._ahead: list[tuple[tuple[float, ...], tuple[float, ...]]] = []  # (position, quaternion)
         self._q = (0.0, 0.0, 0.0, 1.0)
+        self._begun: float | None = None  # when the move with path axes began (None: at the next check)
 
     @property
     def received(self) -> bool:
@@ -51,6 +54,11 @@ class PathReference:
 
     def clear(self) -> None:
         self._t = None
+
+    def begin(self, t: float | None) -> None:
+        """A move with path axes begins at `t` [s] (None: at the next `check`): it waits up to `timeout` for
+        a live reference before the reference counts as lost."""
+        self._begun = t
 
     def set(self, position: Sequence[float], quaternion: Sequence[float], twist: Sequence[float],
             t: float, horizon: Sequence[tuple[Sequence[float], Sequence[float]]] = (),
@@ -135,8 +143,13 @@ class PathReference:
         `error`)."""
         if not laws.path_axes:
             return -1, 0
+        if self._begun is None:
+            self._begun = t
         if T_fixed_eef is None or not self.error(t, T_fixed_eef, R_fixed_control, error, velocity):
-            return laws.path_axes[0], End.PATH_LOST
+            if T_fixed_eef is None or t - self._begun > self.timeout:
+                return laws.path_axes[0], End.PATH_LOST
+            for i in laws.path_axes:  # the stream's first reference is on its way: stand still meanwhile
+                error[i] = velocity[i] = 0.0
         for i in laws.path_axes:
             if 0.0 < laws.laws[i].max_travel <= abs(error[i]):
                 return i, End.PATH_ERROR

@@ -30,6 +30,7 @@ ORIENTATIONS = ("normal", "path", "free")
 CONTACT_FORCE = 3.0  # [N] |F| above which a sample counts as in contact (contact_control's touch force)
 _TO_START_SPEED = 0.05  # [m/s] in free space (a guess: a cautious cobot speed, within the collaborative cap)
 _TOUCH_SPEED = 0.006  # [m/s] a stiff part met faster overshoots the touch's 5 N (the wipe task's)
+_TOUCH_DAMPING = 1000.0  # [N/(m/s)] the law slows from 6 N on (2000: 12 N; README, Paths at a force)
 _MAX_LAG = 0.05  # [m] the tool may fall this far behind the path's reference (an arm slowed by a singularity)
 _PRESS_DAMPING = 2000.0  # [N/(m/s)] force tracking's b (1000 rang between 5 and 14 N through a UR's latency)
 _CLEARANCE = 0.05  # [m] the move to the start comes along the tool's axis over this much more than standoff
@@ -123,7 +124,7 @@ def path_task(goal: PathGoal, tool: FloatArray, name: str = "follow_path") -> Ta
                           {"when": "move_ended",
                            "fail": "contact_control ended the move to the path's start"}]},
             "touch": {
-                "laws": {"z": {"law": "compliant_move", "velocity": _TOUCH_SPEED, "damping": 2000.0,
+                "laws": {"z": {"law": "compliant_move", "velocity": _TOUCH_SPEED, "damping": _TOUCH_DAMPING,
                                "force_limit": 5.0, "max_travel": goal.standoff + 0.02}},
                 "law_frame": "tool",
                 "exits": [{"when": "touch", "next": "press"},
