@@ -74,6 +74,17 @@ def test_driver_options_without_a_driver_are_refused_before_anything_launches(tm
     assert not (tmp_path / "launch.log").exists()
 
 
+def test_a_curved_path_the_arm_cannot_run_is_named_and_nothing_launches(tmp_path):
+    """On the UR3 the move to the curved path's start meets jog_arm's hard stop (a singularity): make demo
+    says so before launching, and the exit status is [CANNOT]'s (nothing failed)."""
+    command = _demo("--robot", "ur3", "--only", "curved_surface", "--output", str(tmp_path))
+    run = _run(command, capture_output=True, text=True, timeout=120, check=False)
+    assert run.returncode == 3, run.stdout + run.stderr
+    assert re.search(r"^\[CANNOT\] curved_surface: this arm cannot do it as planned: the move to the path's "
+                     r"start: condition number \d+\.\d, at or above jog_arm's hard stop 24", run.stdout, re.M)
+    assert not (tmp_path / "launch.log").exists()
+
+
 # Alone (after the parallel suite): beside another worker's simulations the UR3's pressed replay left
 # 10 +- 1.5 N (50 ms means 8.15..11.78 N, docs/measurements.md); the timing cause is not found yet.
 @pytest.mark.alone

@@ -22,7 +22,7 @@ from contact_tasks.path import PosePath
 from contact_tasks.task import Task, TaskError
 from contact_tasks.task_file import parse_task
 
-__all__ = ["ORIENTATIONS", "RAMP", "PathGoal", "PathMetrics", "path_task"]
+__all__ = ["CLEARANCE", "MAX_LAG", "ORIENTATIONS", "RAMP", "PathGoal", "PathMetrics", "path_task"]
 
 #: normal: the tool's axis on the contact normal, the path's turn about it; path: the path's orientation;
 #: free: normal, and the turn about the tool's axis left as it is.
@@ -31,9 +31,9 @@ CONTACT_FORCE = 3.0  # [N] |F| above which a sample counts as in contact (contac
 _TO_START_SPEED = 0.05  # [m/s] in free space (a guess: a cautious cobot speed, within the collaborative cap)
 _TOUCH_SPEED = 0.006  # [m/s] a stiff part met faster overshoots the touch's 5 N (the wipe task's)
 _TOUCH_DAMPING = 1000.0  # [N/(m/s)] the law slows from 6 N on (2000: 12 N; README, Paths at a force)
-_MAX_LAG = 0.05  # [m] the tool may fall this far behind the path's reference (an arm slowed by a singularity)
+MAX_LAG = 0.05  # [m] the tool may fall this far behind the path's reference (an arm slowed by a singularity)
 _PRESS_DAMPING = 2000.0  # [N/(m/s)] force tracking's b (1000 rang between 5 and 14 N through a UR's latency)
-_CLEARANCE = 0.05  # [m] the move to the start comes along the tool's axis over this much more than standoff
+CLEARANCE = 0.05  # [m] the move to the start comes along the tool's axis over this much more than standoff
 RAMP = 0.5  # [s] paths speed up and slow down over this (a speed step on a part with friction sticks)
 ARRIVE_TIME = 5.0  # [s] the tool may come to the path's end this long after its reference (a slowed arm)
 # The press ends once the force along the tool's axis has held at least _PRESS_SETTLED of its target for
@@ -91,8 +91,8 @@ def path_task(goal: PathGoal, tool: FloatArray, name: str = "follow_path") -> Ta
     start = np.asarray(transform(path.positions[0], path.quaternions[0]))
     standoff, far = start.copy(), start.copy()
     standoff[:3, 3] -= goal.standoff * start[:3, 2]
-    far[:3, 3] -= (goal.standoff + _CLEARANCE) * start[:3, 2]
-    held = {"law": "path", "stiffness": 5.0, "max_travel": _MAX_LAG}
+    far[:3, 3] -= (goal.standoff + CLEARANCE) * start[:3, 2]
+    held = {"law": "path", "stiffness": 5.0, "max_travel": MAX_LAG}
     turned = {"law": "path", "stiffness": 2.0, "max_travel": 0.3}
     free_space = {"x": held, "y": held, "z": held, "rx": turned, "ry": turned, "rz": turned}
     approach = [_pose_row(tool), _pose_row(far), _pose_row(standoff)]
@@ -108,6 +108,8 @@ def path_task(goal: PathGoal, tool: FloatArray, name: str = "follow_path") -> Ta
     if goal.orientation != "free":
         follow["rz"] = turned
     ceiling = 2.0 * top + 5.0
+    # the touch's travel at its speed, twice over: an arm held by jog_arm (a singularity) never ends the move
+    touch_time = 2.0 * (goal.standoff + 0.02) / _TOUCH_SPEED + RAMP
     data = {
         "task": name,
         "description": f"a {path.length:.3f} m path at {goal.speed:g} m/s pressing {top:g} N",
@@ -130,7 +132,10 @@ def path_task(goal: PathGoal, tool: FloatArray, name: str = "follow_path") -> Ta
                 "exits": [{"when": "touch", "next": "press"},
                           {"when": "move_ended",
                            "fail": f"no contact within {goal.standoff + 0.02:g} m along the tool's axis from "
-                           "the path's start"}]},
+                           "the path's start"},
+                          {"when": "timeout", "after": touch_time,
+                           "fail": f"no contact within {touch_time:.0f} s: the tool did not get there (an "
+                           "arm stopped near a singularity or a joint limit: jog_arm's ~status)"}]},
             "press": {
                 "laws": pressing, "law_frame": "tool",
                 # the law frame's z is the tool's: the part pushes the tool back along -z

@@ -13,6 +13,8 @@ every problem found:
   * the scene's obstacle not where the compliant move can meet it (thesis_demos' preflight);
   * named poses whose `start` is not the scene's start pose;
   * held joints (outside the arm) that the scene and jog_arm hold at different positions.
+The curved demonstration's path (`path_reach`) is followed too; what the arm cannot do there is not a problem
+of the package but a [CANNOT] of make demo (`check_package.last_cannot`).
 """
 
 from __future__ import annotations
@@ -48,10 +50,12 @@ from thesis_demos.geometry import (
     preflight,
     tool_radius,
 )
+from thesis_demos.scenarios import PathDemo
 
 from robot_setup.analysis import LENGTH_SCALE, MIN_JOINT_HEIGHT, MIN_MARGIN, analyse_pose, lowest_joint
 from robot_setup.collisions import CollisionChecker
 from robot_setup.hold_check import hold_problems
+from robot_setup.path_reach import curved_path_reach
 
 __all__ = [
     "DEMOS",
@@ -140,11 +144,15 @@ def _description(args_path: str) -> tuple[str, argparse.Namespace]:
 def check_package(root: str) -> list[str]:
     """Every problem of the robot package at `root`, in plain words (empty: none).
 
-    The analysis lines (start pose, motions) are appended to `check_package.last_analysis` for printing.
+    The analysis lines (start pose, motions) are appended to `check_package.last_analysis` for printing;
+    the demonstrations beyond the thesis's four that the arm cannot do as planned (not a problem of the
+    package: make demo says [CANNOT] and leaves them out) go to `check_package.last_cannot`, name -> reason.
     """
     problems: list[str] = []
     info: list[str] = []
+    cannot: dict[str, str] = {}
     check_package.last_analysis = info  # type: ignore[attr-defined]
+    check_package.last_cannot = cannot  # type: ignore[attr-defined]
     cfg = os.path.join(root, "config")
     try:
         urdf, args = _description(os.path.join(cfg, "description.args"))
@@ -237,6 +245,13 @@ def check_package(root: str) -> list[str]:
             f"jog_arm.yaml singularity_threshold {threshold:g}: the demos' motions reach condition number "
             f"{report.worst_condition:.2f}, so jog_arm would slow them (raise it above that)"
         )
+    if obstacle is not None and report.reachable:
+        curved = curved_path_reach(arm, q0, obstacle.top_centre, PathDemo.radius, geometry.curved_length,
+                                   geometry.curved_middle, PathDemo.speed, threshold, hard_stop, scale)
+        if curved.reason:
+            cannot["curved_surface"] = curved.reason
+        info.append(f"curved_surface's path: condition <= {curved.worst_condition:.2f}, "
+                    + (f"[CANNOT] {curved.reason}" if curved.reason else f"lag <= {curved.lag * 1e3:.1f} mm"))
     finite = [m for m in report.margins if math.isfinite(m)]
     info.append(
         f"start pose: tool tip at ({tip_xyz[0]:.3f}, {tip_xyz[1]:.3f}, {tip_xyz[2]:.3f}) m, condition number "
