@@ -221,7 +221,7 @@ class MujocoDriverNode:
                     if publish[i]:
                         tripped[i] = port.read_state()
                     else:
-                        port.sim_time = self._sim_time
+                        port.skip_state()
             current = all(publish)
             pacer.step_done()
             for i, port in enumerate(ports):

@@ -77,6 +77,10 @@ class WrenchSpec:
         drift_force, drift_torque: Stationary standard deviation of the slow drift (AR(1)) [N, Nm], idem.
         drift_time_constant: The drift's correlation time [s] (0: no drift).
         lag: Time constant of the first-order filter on the value [s] (0: none).
+        period_mean: The value is the mean of the simulated sensor's wrench over the publication period
+            (every physics step since the last publication), not its value at the publishing step: a driver
+            that estimates the wrench at a faster rate than it publishes, from filtered signals, carries no
+            alias of the contact's faster ringing.
         contact_shift_threshold: A contact force above this [N] shifts the zero once released (0: never).
         contact_shift_fraction: The shift's size as a fraction of the contact's peak force.
         seed: Random seed of the offset's shape, the noise, the drift and the shifts.
@@ -100,6 +104,7 @@ class WrenchSpec:
     drift_torque: float | tuple[float, ...] = 0.0
     drift_time_constant: float = 0.0
     lag: float = 0.0
+    period_mean: bool = False
     contact_shift_threshold: float = 0.0
     contact_shift_fraction: float = 0.0
     seed: int = 0
@@ -306,6 +311,13 @@ def _per_axis(data: Mapping[str, Any], key: str, where: str) -> float | tuple[fl
     return _number(data, key, where, 0.0)
 
 
+def _flag(data: Mapping[str, Any], key: str, where: str) -> bool:
+    value = data.get(key, False)
+    if not isinstance(value, bool):
+        raise ProfileError(f"{where}.{key}: true or false, got {value!r}")
+    return value
+
+
 def _string(data: Mapping[str, Any], key: str, where: str, default: str | None = None) -> str:
     value = data.get(key, default)
     if value is None or not isinstance(value, str) or (default is None and not value):
@@ -494,6 +506,7 @@ def load_profile(name_or_path: str, options: Mapping[str, Any] | None = None) ->
         drift_torque=_per_axis(w, "drift_torque", f"{where}.wrench"),
         drift_time_constant=_number(w, "drift_time_constant", f"{where}.wrench", 0.0),
         lag=_number(w, "lag", f"{where}.wrench", 0.0),
+        period_mean=_flag(w, "period_mean", f"{where}.wrench"),
         contact_shift_threshold=_number(w, "contact_shift_threshold", f"{where}.wrench", 0.0),
         contact_shift_fraction=_number(w, "contact_shift_fraction", f"{where}.wrench", 0.0),
         seed=int(_number(w, "seed", f"{where}.wrench", 0)),

@@ -40,6 +40,7 @@ from mujoco_driver.profiles import DriverProfile
 from mujoco_driver.ros_emulation import EmulatedDriver
 from mujoco_driver.scene import surface_truth
 from mujoco_driver.sim import CommandError, Simulation
+from mujoco_driver.wrench_models import PeriodMean
 
 __all__ = ["ArmPort", "PortNames"]
 
@@ -124,6 +125,8 @@ class ArmPort:
         self.sim_time = 0.0
         # The published wrench: the simulated sensor's, or the emulated driver's (both filled in place).
         self._wrench_out = self._w if self.driver is None else self.driver.wrench
+        # A profile's `period_mean`: the sensor's wrench over the steps between publications.
+        self._mean = PeriodMean() if profile is not None and profile.wrench.period_mean else None
 
         self._joint_msg = JointState(name=list(sim.joint_names))
         self._wrench_msg = WrenchStamped()
@@ -203,6 +206,13 @@ class ArmPort:
                 self.sim.set_velocity_targets(self._zero)
                 rospy.loginfo_throttle(_WARN_PERIOD, "mujoco_driver: velocity commands stopped: stopping")
 
+    def skip_state(self) -> None:
+        """Under the lock, after a step that publishes nothing: its time, and its wrench toward the period's
+        mean when the profile asks for it."""
+        self.sim_time = self.sim.time
+        if self._mean is not None:
+            self._mean.add(self.sim.wrench(out=self._w))
+
     def read_state(self) -> bool:
         """Under the lock: the state into the buffers; True if an emulated reflex tripped."""
         sim = self.sim
@@ -211,6 +221,8 @@ class ArmPort:
         np.take(data.qvel, self._dof_adr, out=self._qd)
         np.take(data.qfrc_actuator, self._dof_adr, out=self._tau)
         sim.wrench(out=self._w)
+        if self._mean is not None:
+            self._mean.take(self._w)
         sim.world_pose(self._xpos_src, self._xquat_src, self._xpos, self._xquat)
         self.sim_time = sim.time
         return self.driver.update(self._w) if self.driver is not None else False

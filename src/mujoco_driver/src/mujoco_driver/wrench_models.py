@@ -31,8 +31,8 @@ import numpy as np
 
 from mujoco_driver.profiles import WrenchSpec
 
-__all__ = ["RateDivider", "Reflex", "WrenchModel", "change_frame", "gravity_wrench", "set_payload_weight",
-           "wrench_from_joint_torques"]
+__all__ = ["PeriodMean", "RateDivider", "Reflex", "WrenchModel", "change_frame", "gravity_wrench",
+           "set_payload_weight", "wrench_from_joint_torques"]
 
 GRAVITY = np.array([0.0, 0.0, -9.81])
 # Damping of the least-squares inverse: none while the Jacobian's smallest singular value (mixed units: m
@@ -88,6 +88,27 @@ def change_frame(wrench: np.ndarray, r_from: np.ndarray, p_from: np.ndarray, r_t
     force_w = r_from @ wrench[:3]
     torque_w = r_from @ wrench[3:] + np.cross(p_from - p_to, force_w)
     return np.concatenate([r_to.T @ force_w, r_to.T @ torque_w])
+
+
+class PeriodMean:
+    """The mean of the wrenches of the steps between two publications (a profile's `period_mean`): `add`
+    each step that publishes nothing, then `take` at the publishing step."""
+
+    def __init__(self) -> None:
+        self._sum = np.zeros(6)
+        self._count = 0
+
+    def add(self, wrench: np.ndarray) -> None:
+        self._sum += wrench
+        self._count += 1
+
+    def take(self, wrench: np.ndarray) -> None:
+        """Replaces the publishing step's `wrench` (in place) by the mean of it and those added since."""
+        if self._count:
+            wrench += self._sum
+            wrench /= self._count + 1
+            self._sum[:] = 0.0
+            self._count = 0
 
 
 class WrenchModel:
