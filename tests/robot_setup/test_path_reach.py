@@ -8,9 +8,9 @@ import pathlib
 
 import numpy as np
 import pytest
-from contact_tasks.path_task import MAX_LAG
+from contact_tasks.path_task import MAX_LAG, PATH_STIFFNESS
 from robot_setup.check import check_package
-from robot_setup.path_reach import PATH_GAIN, predicted_lag
+from robot_setup.path_reach import predicted_lag
 
 SRC = pathlib.Path(__file__).resolve().parents[2] / "src"
 SPEED = 0.02  # [m/s] the curved demonstration's
@@ -25,7 +25,7 @@ def test_a_slowed_stretch_leaves_the_lag_the_path_law_settles_at():
     # Scaled to s = 0.5 all along (condition 10 of 8..12, rising): the law's catch-up k e balances the
     # slow-down when s (v + k e) = v, so e = v (1 - s) / (s k) = 4 mm.
     lag, arrives = predicted_lag(np.linspace(10.0, 10.0 + 1e-6, 201), 0.005, SPEED, 8.0, 12.0, 5.0)
-    assert arrives and lag == pytest.approx(SPEED * 0.5 / (0.5 * PATH_GAIN), rel=0.05)
+    assert arrives and lag == pytest.approx(SPEED * 0.5 / (0.5 * PATH_STIFFNESS), rel=0.05)
 
 
 def test_the_hard_stop_holds_the_tool_until_the_path_law_ends_the_move():

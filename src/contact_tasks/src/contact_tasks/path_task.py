@@ -22,7 +22,8 @@ from contact_tasks.path import PosePath
 from contact_tasks.task import Task, TaskError
 from contact_tasks.task_file import parse_task
 
-__all__ = ["CLEARANCE", "MAX_LAG", "ORIENTATIONS", "RAMP", "PathGoal", "PathMetrics", "path_task"]
+__all__ = ["ARRIVE_TIME", "CLEARANCE", "MAX_LAG", "ORIENTATIONS", "PATH_STIFFNESS", "RAMP", "PathGoal",
+           "PathMetrics", "path_task"]
 
 #: normal: the tool's axis on the contact normal, the path's turn about it; path: the path's orientation;
 #: free: normal, and the turn about the tool's axis left as it is.
@@ -31,6 +32,7 @@ CONTACT_FORCE = 3.0  # [N] |F| above which a sample counts as in contact (contac
 _TO_START_SPEED = 0.05  # [m/s] in free space (a guess: a cautious cobot speed, within the collaborative cap)
 _TOUCH_SPEED = 0.006  # [m/s] a stiff part met faster overshoots the touch's 5 N (the wipe task's)
 MAX_LAG = 0.05  # [m] the tool may fall this far behind the path's reference (an arm slowed by a singularity)
+PATH_STIFFNESS = 5.0  # [1/s] the path law's k on the translations, to the start and along the path
 _PRESS_DAMPING = 2000.0  # [N/(m/s)] force tracking's b (1000 rang between 5 and 14 N through a UR's latency)
 CLEARANCE = 0.05  # [m] the move to the start comes along the tool's axis over this much more than standoff
 RAMP = 0.5  # [s] paths speed up and slow down over this (a speed step on a part with friction sticks)
@@ -91,7 +93,7 @@ def path_task(goal: PathGoal, tool: FloatArray, name: str = "follow_path") -> Ta
     standoff, far = start.copy(), start.copy()
     standoff[:3, 3] -= goal.standoff * start[:3, 2]
     far[:3, 3] -= (goal.standoff + CLEARANCE) * start[:3, 2]
-    held = {"law": "path", "stiffness": 5.0, "max_travel": MAX_LAG}
+    held = {"law": "path", "stiffness": PATH_STIFFNESS, "max_travel": MAX_LAG}
     turned = {"law": "path", "stiffness": 2.0, "max_travel": 0.3}
     free_space = {"x": held, "y": held, "z": held, "rx": turned, "ry": turned, "rz": turned}
     approach = [_pose_row(tool), _pose_row(far), _pose_row(standoff)]

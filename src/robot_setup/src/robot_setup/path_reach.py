@@ -20,7 +20,7 @@ import numpy as np
 import pinocchio as pin
 from compliant_common.typedefs import FloatArray
 from contact_control.frames import quaternion_matrix
-from contact_tasks.path_task import CLEARANCE, MAX_LAG, PathGoal
+from contact_tasks.path_task import ARRIVE_TIME, CLEARANCE, MAX_LAG, PATH_STIFFNESS, PathGoal
 from jog_arm.kinematics import ArmModel
 from jog_arm.limits import singularity_scale
 from thesis_demos.surfaces import cylinder_path
@@ -30,7 +30,6 @@ from robot_setup.analysis import condition_number, margins, solve_ik
 __all__ = ["PathReach", "curved_path_reach", "predicted_lag"]
 
 STEP = 0.005  # [m] between the path's poses checked
-PATH_GAIN = 5.0  # [1/s] the path law's stiffness along the path (contact_tasks' follow_path)
 LAG_SHARE = 0.8  # a predicted lag above this share of the path's allowed lag is too close to call
 AT_LIMIT = 0.01  # [rad] a joint this close to its limit stops there
 _BRANCH_JUMP = 0.5  # [rad]
@@ -63,8 +62,8 @@ def _line(a: pin.SE3, b: pin.SE3, steps: int) -> list[pin.SE3]:
             for k in range(1, steps + 1)]
 
 
-def predicted_lag(conditions: Sequence[float], step: float, speed: float, threshold: float, hard_stop: float,
-         arrive_time: float) -> tuple[float, bool]:
+def predicted_lag(conditions: Sequence[float], step: float, speed: float, threshold: float,
+                  hard_stop: float, arrive_time: float = ARRIVE_TIME) -> tuple[float, bool]:
     """Along a path of `conditions` every `step` m, run at `speed` [m/s]: (the largest lag of the tool
     behind the reference [m], whether the tool reaches the end within `arrive_time` s after it)."""
     n = len(conditions)
@@ -78,7 +77,7 @@ def predicted_lag(conditions: Sequence[float], step: float, speed: float, thresh
         scale = singularity_scale(conditions[i], threshold, hard_stop, toward)
         s_ref = min(s_ref + speed * dt, length)
         lag = s_ref - s_tool
-        s_tool += scale * (speed * (s_ref < length) + PATH_GAIN * lag) * dt
+        s_tool += scale * (speed * (s_ref < length) + PATH_STIFFNESS * lag) * dt
         worst = max(worst, s_ref - s_tool)
         if s_tool >= length - 1e-4:
             return worst, True
@@ -88,7 +87,7 @@ def predicted_lag(conditions: Sequence[float], step: float, speed: float, thresh
 
 def curved_path_reach(arm: ArmModel, q0: FloatArray, top: Sequence[float], radius: float, length: float,
                       middle: float, speed: float, threshold: float, hard_stop: float,
-                      length_scale: float, arrive_time: float = 5.0) -> PathReach:
+                      length_scale: float, arrive_time: float = ARRIVE_TIME) -> PathReach:
     """The curved demonstration's path (`length` m over the nominal cylinder of `radius` whose highest
     point is `top`, centred `middle` rad from it toward +x, at `speed` m/s) from joint angles `q0`."""
     start = arm.frame_pose(np.asarray(q0, dtype=float), arm.tip_frame)
@@ -114,14 +113,15 @@ def curved_path_reach(arm: ArmModel, q0: FloatArray, top: Sequence[float], radiu
                                  "singularity; the tool's orientation follows the cylinder's normal)",
                                  worst, 0.0, low)
             q = solved
-            c, m = condition_number(arm, q, length_scale), float(np.min(margins(arm, q)))
+            c, left = condition_number(arm, q, length_scale), margins(arm, q)
+            m = float(np.min(left))
             worst, low = max(worst, c), min(low, m)
             if c >= hard_stop:
                 return PathReach(f"{where}: condition number {c:.1f}, at or above jog_arm's hard stop "
                                  f"{hard_stop:g} (hard_stop_singularity_threshold): the arm stops there",
                                  worst, 0.0, low)
             if m < AT_LIMIT:
-                name = arm.joint_names[int(np.argmin(margins(arm, q)))]
+                name = arm.joint_names[int(np.argmin(left))]
                 return PathReach(f"{where}: {name} reaches its limit", worst, 0.0, low)
             if leg == "the touch":
                 on_path = [c]
