@@ -145,8 +145,10 @@ class JogCalcs:
             self.model.upper,
             self.model.max_velocity,
             self.model.max_acceleration,
-            settings.joint_limit_margin,
-            settings.joint_limit_slowdown_width,
+            [settings.prismatic_limit_margin if linear else settings.joint_limit_margin
+             for linear in self.model.prismatic],
+            [settings.prismatic_slowdown_width if linear else settings.joint_limit_slowdown_width
+             for linear in self.model.prismatic],
             settings.pub_period,
         )
         self._filter = LowPassFilter(settings.low_pass_filter_coeff, 6)  # on the twist

@@ -106,6 +106,8 @@ class ArmModel:
         # (q index, v index) of the 1-value joints and of the (cos, sin) continuous ones, model order.
         joints = [model.joints[jid] for jid in range(1, model.njoints)]
         self.continuous: tuple[bool, ...] = tuple(joint.nq == 2 for joint in joints)
+        #: Linear joints (a rail): positions in m, velocities in m/s.
+        self.prismatic: tuple[bool, ...] = tuple(joint.shortname() in _PRISMATIC for joint in joints)
         self._plain = not any(self.continuous)  # q is the angle array itself
         self._single = [(j.idx_q, j.idx_v) for j in joints if j.nq == 1]
         self._unbounded = [(j.idx_q, j.idx_v) for j in joints if j.nq == 2]
@@ -273,6 +275,9 @@ class ArmModel:
             pose = pin.updateFramePlacement(self.model, data, base_id).actInv(pose)
         homogeneous: FloatArray = pose.homogeneous
         return homogeneous
+
+
+_PRISMATIC = ("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned")
 
 
 def frame_index(model: pin.Model, name: str) -> int:

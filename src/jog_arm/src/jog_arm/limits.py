@@ -53,9 +53,10 @@ class JointLimiter:
         upper: Upper position limits [rad] (+inf: none).
         max_velocity: Velocity limits [rad/s].
         max_acceleration: Acceleration limits [rad/s²].
-        margin: Distance [rad] kept from each position limit.
-        slowdown_width: Width [rad] of the zone before the margin where the allowed speed toward the
-            limit falls linearly from the velocity limit to zero (0 = no ramp, braking only).
+        margin: Distance [rad, m] kept from each position limit: one for all joints, or one per joint.
+        slowdown_width: Width [rad, m] of the zone before the margin where the allowed speed toward the
+            limit falls linearly from the velocity limit to zero (0 = no ramp, braking only); one for all
+            joints or one per joint.
         period: Control period [s].
     """
 
@@ -65,12 +66,12 @@ class JointLimiter:
         upper: Sequence[float] | FloatArray,
         max_velocity: Sequence[float] | FloatArray,
         max_acceleration: Sequence[float] | FloatArray,
-        margin: float,
-        slowdown_width: float,
+        margin: float | Sequence[float],
+        slowdown_width: float | Sequence[float],
         period: float,
     ) -> None:
-        self.lower_stop = np.asarray(lower, dtype=float) + margin
-        self.upper_stop = np.asarray(upper, dtype=float) - margin
+        self.lower_stop = np.asarray(lower, dtype=float) + np.asarray(margin, dtype=float)
+        self.upper_stop = np.asarray(upper, dtype=float) - np.asarray(margin, dtype=float)
         self.max_velocity = np.array(max_velocity, dtype=float)
         self.max_acceleration = np.array(max_acceleration, dtype=float)
         self.period = float(period)
@@ -79,11 +80,9 @@ class JointLimiter:
         self._inv_v = (1.0 / self.max_velocity).tolist()
         self._step = (self.max_acceleration * self.period).tolist()  # largest velocity change per cycle
         self._two_a = (2.0 * self.max_acceleration).tolist()
-        self._ramp = (
-            (self.max_velocity / slowdown_width).tolist()
-            if slowdown_width > 0.0
-            else [math.inf] * len(self._lo)
-        )
+        width = np.broadcast_to(np.asarray(slowdown_width, dtype=float), self.max_velocity.shape)
+        self._ramp = [float(v / w) if w > 0.0 else math.inf
+                      for v, w in zip(self.max_velocity, width, strict=True)]
         self._inv_period = 1.0 / self.period
         # Position checks loop over the joints with at least one finite stop only, with their constants.
         self._bounded = [

@@ -164,8 +164,11 @@ class JogSettings:
     num_outgoing_halt_msgs_to_publish: int = param(
         10, ge=1, doc="times the final zero command is sent"
     )
-    joint_limit_margin: float = _nonneg(0.1, "rad", "distance kept from each position limit")
+    joint_limit_margin: float = _nonneg(0.1, "rad", "distance kept from each revolute joint's position limit")
     joint_limit_slowdown_width: float = _nonneg(0.2, "rad", "ramp-down zone before the margin")
+    # A rail's 0.1 m would be a tenth of its travel: prismatic joints have their own, in metres.
+    prismatic_limit_margin: float = _nonneg(0.01, "m", "distance kept from each prismatic joint's limit")
+    prismatic_slowdown_width: float = _nonneg(0.05, "m", "a prismatic joint's ramp-down zone")
     default_max_acceleration: float = _pos(
         3.0, "rad/s²", "for joints without an override (URDFs carry none)"
     )

@@ -42,7 +42,7 @@ class NamedPoseSettings:
         doc="joint-space acceleration limit of a move",
     )
     goal_tolerance: float = param(
-        0.01, unit="rad", gt=0.0, doc="`~move_to` succeeds once every joint is this close to the pose"
+        0.01, unit="rad, m", gt=0.0, doc="`~move_to` succeeds once every joint is this close to the pose"
     )
     settle_time: float = param(
         3.0, unit="s", ge=0.0, doc="`~move_to` fails this long after the planned end if not arrived"

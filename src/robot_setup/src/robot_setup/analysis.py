@@ -76,9 +76,10 @@ def condition_number(arm: ArmModel, q: np.ndarray, length_scale: float = LENGTH_
 
 
 def margins(arm: ArmModel, q: np.ndarray) -> np.ndarray:
-    """Distance of each joint to its nearer position limit [rad]; inf for unbounded (continuous) joints."""
+    """Distance of each joint to its nearer position limit [rad]; inf for unbounded (continuous) joints. A
+    prismatic joint's metres count as radians at LENGTH_SCALE (MIN_MARGIN's 0.15 rad is 6 cm of a rail)."""
     q = np.asarray(q, dtype=float)
-    return np.minimum(q - arm.lower, arm.upper - q)
+    return np.minimum(q - arm.lower, arm.upper - q) / np.where(arm.prismatic, LENGTH_SCALE, 1.0)
 
 
 def lowest_joint(arm: ArmModel, q: np.ndarray) -> float:

@@ -170,14 +170,11 @@ def _held_positions(
     limits (URDF order).
 
     Raises:
-        GeneratorError: HELD names a joint of the chain, one that is not in the description, or a position
-            outside its limits.
+        GeneratorError: HELD names a joint that is not in the description, or a position outside its limits.
     """
     joints = {j.get("name", ""): j for j in ET.fromstring(urdf_xml).findall("joint")
               if j.get("type") not in ("fixed", "floating", "planar")}
     for name in given:
-        if name in chain:
-            raise GeneratorError(f"HELD={name}: {name} is an arm joint (between BASE and TIP={spec.tip})")
         if name not in joints:
             raise GeneratorError(f"HELD={name}: not a movable joint of the description (outside the arm: "
                                  f"{[j for j in joints if j not in chain]})")
@@ -201,6 +198,7 @@ def _held_positions(
 
 def _round(value: float, step: float) -> float:
     return round(round(value / step) * step, 6)
+
 
 
 def _demos(scale: float) -> tuple[float, DemoGeometry]:
@@ -273,6 +271,13 @@ def _plan_robot(spec: RobotSpec, log: Callable[[str], object]) -> Plan:
     if base not in links:
         raise GeneratorError(f"BASE={base!r} is not a link of {spec.urdf}; links: {sorted(links)}")
     chain = _chain(children, base, spec.tip)
+    # A HELD linear axis between BASE and TIP (a rail under the arm) is locked where HELD says.
+    kinds = {j.get("name", ""): j.get("type") for j in ET.fromstring(stock).findall("joint")}
+    for name, _ in spec.held:
+        if name in chain and kinds[name] != "prismatic":
+            raise GeneratorError(f"HELD={name}: {name} is an arm joint (between BASE and TIP={spec.tip}); of "
+                                 "those only a linear axis (a prismatic joint, a rail) can be held")
+    chain = [j for j in chain if j not in dict(spec.held)]
     removed = tuple(child for child, _, _ in children.get(spec.tip, []))
     rpy = spec.tool_rpy if spec.tool_rpy is not None else (0.0, 0.0, 0.0)
     mounter = Mounter(stock, spec, removed, chain, ())
@@ -350,6 +355,10 @@ def _plan_robot(spec: RobotSpec, log: Callable[[str], object]) -> Plan:
         joint = next(j for j in robot.findall("joint") if j.get("name") == name)
         limit = joint.find("limit")
         efforts.append(float(limit.get("effort", 0.0)) if limit is not None else 0.0)
+    linear = [next(j for j in robot.findall("joint") if j.get("name") == n).get("type") == "prismatic"
+              for n in servo_joints]
+    # The same rule for a prismatic joint, in N/m per N (a rail's 1000 N: 20000 N/m). A stiffer rail (the
+    # tool stiffness of a 0.4 m lever, 125000 N/m) passed free but made a held rail ring: robot_setup README.
     kp = tuple(_round(min(KP_MAX, max(KP_MIN, KP_PER_NM * e)), 100.0) if e > 0 else KP_MIN for e in efforts)
     kv = tuple(_round(k * KV_RATIO, 1.0) for k in kp)
     armature = 0.2 if max(efforts) > 100.0 else 0.1
@@ -360,7 +369,9 @@ def _plan_robot(spec: RobotSpec, log: Callable[[str], object]) -> Plan:
         f"{acceleration * per_joint:.2f} m/s^2 along X, Y and Z at the start pose")
     plan = Plan(
         spec=spec, source=source, removed=removed, base=base, tool_rpy=rpy, adapter=adapter, held=held,
-        servo_joints=servo_joints, urdf_xml=urdf_xml, joints=arm.joint_names,
+        servo_joints=servo_joints,
+        linear=tuple(n for n, lin in zip(servo_joints, linear, strict=True) if lin),
+        urdf_xml=urdf_xml, joints=arm.joint_names,
         reach=reach, geometry=geometry, gap=gap, obstacle_size=obstacle_size,
         obstacle_position=obstacle_position, start=start, tip_in_base=tip_in_base, home=home,
         threshold=threshold, hard_stop=hard_stop,
@@ -399,11 +410,14 @@ def analysis_lines(plan: Plan, arm: ArmModel | None = None) -> list[str]:
     s = plan.start
     finite = [(n, m) for n, m in zip(plan.joints, s.margins, strict=True) if math.isfinite(m)]
     closest = min(finite, key=lambda nm: nm[1]) if finite else ("(all continuous)", math.inf)
+    names = arm.joint_names if arm is not None else ()
+    linear = closest[0] in names and arm is not None and arm.prismatic[names.index(closest[0])]
+    margin = f"{closest[1] * LENGTH_SCALE:.3f} m" if linear else f"{closest[1]:.2f} rad"
     lines = [
         f"start pose: tool pointing down, tool tip at ({plan.tip_in_base[0]:.3f}, {plan.tip_in_base[1]:.3f}, "
         f"{plan.tip_in_base[2]:.3f}) m in {plan.base}; condition number {s.condition:.2f} (length scale "
         f"{LENGTH_SCALE} m)",
-        f"joint-limit margin at the start pose {closest[1]:.2f} rad ({closest[0]}), at least "
+        f"joint-limit margin at the start pose {margin} ({closest[0]}), at least "
         f"{s.min_margin:.2f} rad "
         "on the demos' motions",
     ]

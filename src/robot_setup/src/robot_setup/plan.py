@@ -143,3 +143,4 @@ class Plan:
     driver: DriverInterface  # the hardware files' driver (generic, or from the DRIVER profile)
     acceleration: float  # [rad/s^2] jog_arm's joint acceleration limit (default_max_acceleration)
     servo_note: str = ""  # why kp and kv are below the effort rule's ("": they are not)
+    linear: tuple[str, ...] = ()  # the servo joints that are prismatic (a rail): gains in N/m

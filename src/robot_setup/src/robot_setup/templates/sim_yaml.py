@@ -30,6 +30,13 @@ def servo_note(plan: Plan) -> str:
     return f";\n# then {plan.servo_note}" if plan.servo_note else ""
 
 
+def linear_note(plan: Plan) -> str:
+    """How a prismatic joint's gains follow from the rule, as the comment's tail ("" without one)."""
+    if not plan.linear:
+        return ""
+    return f";\n# {', '.join(plan.linear)} (prismatic): the same numbers in N/m per N of effort"
+
+
 def sim_yaml(plan: Plan) -> str:
     name = plan.spec.name
     s = plan.start
@@ -67,11 +74,11 @@ obstacle:
   rpy: [0.0, 0.0, 0.0]              # [rad]
 
 # Joint servos: torque = kp (q_set - q) + kv (qd_set - qd) + payload feed-forward, limited to the URDF
-# efforts ({', '.join(num(e) for e in plan.efforts)} Nm). kp = 120 Nm/rad per Nm of effort (1000..20000), kv = 0.02 s x kp{servo_note(plan)}.
+# efforts ({', '.join(num(e) for e in plan.efforts)} Nm; N for a prismatic joint). kp = 120 Nm/rad per Nm of effort (1000..20000), kv = 0.02 s x kp{servo_note(plan)}{linear_note(plan)}.
 servo:
-  kp:                      # [Nm/rad]
+  kp:                      # [Nm/rad; N/m for a prismatic joint]
 {joints(plan.kp, plan.servo_joints, "{:.1f}", 4)}
-  kv:                      # [Nm s/rad]
+  kv:                      # [Nm s/rad; N s/m]
 {joints(plan.kv, plan.servo_joints, "{:.1f}", 4)}
   armature: {plan.armature}            # reflected rotor inertia per joint [kg m^2]
   max_acceleration: {plan.acceleration + 1.0:.1f}    # [rad/s^2] setpoint acceleration limit (above jog_arm's {plan.acceleration:g} rad/s^2)
