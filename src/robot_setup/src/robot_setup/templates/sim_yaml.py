@@ -74,11 +74,11 @@ obstacle:
   rpy: [0.0, 0.0, 0.0]              # [rad]
 
 # Joint servos: torque = kp (q_set - q) + kv (qd_set - qd) + payload feed-forward, limited to the URDF
-# efforts ({', '.join(num(e) for e in plan.efforts)} Nm; N for a prismatic joint). kp = 120 Nm/rad per Nm of effort (1000..20000), kv = 0.02 s x kp{servo_note(plan)}{linear_note(plan)}.
+# efforts ({', '.join(num(e) for e in plan.efforts)} Nm{"; N for a prismatic joint" if plan.linear else ""}). kp = 120 Nm/rad per Nm of effort (1000..20000), kv = 0.02 s x kp{servo_note(plan)}{linear_note(plan)}.
 servo:
-  kp:                      # [Nm/rad; N/m for a prismatic joint]
+  kp:                      # [Nm/rad{"; N/m for a prismatic joint" if plan.linear else ""}]
 {joints(plan.kp, plan.servo_joints, "{:.1f}", 4)}
-  kv:                      # [Nm s/rad; N s/m]
+  kv:                      # [Nm s/rad{"; N s/m" if plan.linear else ""}]
 {joints(plan.kv, plan.servo_joints, "{:.1f}", 4)}
   armature: {plan.armature}            # reflected rotor inertia per joint [kg m^2]
   max_acceleration: {plan.acceleration + 1.0:.1f}    # [rad/s^2] setpoint acceleration limit (above jog_arm's {plan.acceleration:g} rad/s^2)
