@@ -1,8 +1,8 @@
 """Can the simulated arm stand at its start pose and reach its named poses? `make check-robot` (and make
 robot's own check) holds the arm at sim.yaml's start pose under the tool's weight and moves it to each pose of
 named_poses.yaml and back, in MuJoCo alone (mujoco_driver's Simulation, its servos as the driver runs them; no
-ROS), and names the joint that ends farther off than named_poses' goal tolerance (robot_setup README, *What
-make robot decides*).
+ROS), and names the joint that ends farther off than named_poses' goal tolerance, or the link of the arm that
+rests on the table or the obstacle there (robot_setup README, *What make robot decides*).
 
 Why: an arm whose servos cannot carry it (weak efforts in the URDF, heavy links) passed the kinematic checks
 and then stopped `make demo` before its first demonstration ("named pose 'start' failed: did not reach
@@ -36,6 +36,35 @@ def _touching(sim: Simulation) -> list[str]:
                            model.body(model.geom_bodyid[c.geom2]).name or "world")))
              for c in data.contact[:data.ncon]}
     return [f"{a} / {b}" for a, b in sorted(pairs)]
+
+
+def _resting(sim: Simulation) -> list[str]:
+    """The links the arm's joints move (not the tool's; not a held base's wheels on the floor; not the first
+    link, which turns on the base on the table: panda_collision.urdf's link1 reaches into it) touching the
+    table or the obstacle now. The start pose search sees the table but not the block placed under the tool
+    after it; a forearm resting on the block drags on it in every demonstration (a rail arm's follower
+    drifted 2.4 mm sideways so, its replay and peg in hole failed)."""
+    model, data = sim.scene.model, sim.data
+    tool = sim.scene.sensor_body
+    parents = model.body_parentid
+    arm_bodies = {int(model.jnt_bodyid[model.joint(n).id]) for n in sim.arm_joint_names}
+    first = min(arm_bodies)  # bodies are numbered parents first
+
+    def below(b: int, roots: set[int]) -> bool:
+        while b > 0:
+            if b in roots:
+                return True
+            b = int(parents[b])
+        return False
+
+    links = set()
+    for c in data.contact[:data.ncon]:
+        a, b = int(model.geom_bodyid[c.geom1]), int(model.geom_bodyid[c.geom2])
+        if c.dist < 0.0 and 0 in (a, b):
+            link = b if a == 0 else a
+            if link and link != first and below(link, arm_bodies) and not below(link, {tool}):
+                links.add(model.body(link).name)
+    return sorted(links)
 
 
 def _why(sim: Simulation, i: int, kp: float) -> str:
@@ -77,6 +106,11 @@ def hold_problems(urdf_xml: str, scene: Mapping[str, Any], poses: Mapping[str, M
         sim.set_position_targets(goal)
         travel = float(np.max(np.abs(goal - sim.qpos) / sim.scene.velocity_limit))
         sim.step(round((travel + HOLD_TIME) / sim.dt))
+        resting = _resting(sim) if name == "start" else []
+        if resting:
+            problems.append(f"start pose: the simulated arm's {', '.join(resting)} rests on the table or the "
+                            "obstacle there (the demonstrations would drag it along)")
+            break
         i, error = _worst(sim, goal)
         if error > tolerance:
             joint = sim.joint_names[i]
