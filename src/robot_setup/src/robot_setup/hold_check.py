@@ -40,7 +40,7 @@ def _touching(sim: Simulation) -> list[str]:
 
 def _resting(sim: Simulation) -> list[str]:
     """The links the arm's joints move (not the tool's; not a held base's wheels on the floor; not the first
-    link, which turns on the base on the table: panda_collision.urdf's link1 reaches into it) touching the
+    link, which turns on the base on the table: a collision mesh of it may reach into the table) touching the
     table or the obstacle now. The start pose search sees the table but not the block placed under the tool
     after it; a forearm resting on the block drags on it in every demonstration (a rail arm's follower
     drifted 2.4 mm sideways so, its replay and peg in hole failed)."""
