@@ -200,7 +200,6 @@ def _round(value: float, step: float) -> float:
     return round(round(value / step) * step, 6)
 
 
-
 def _demos(scale: float) -> tuple[float, DemoGeometry]:
     """(obstacle gap [m], the demonstrations' numbers) at `scale` of the thesis's."""
     gap = _round(max(0.04, 0.07 * scale), 0.005)
@@ -272,7 +271,7 @@ def _plan_robot(spec: RobotSpec, log: Callable[[str], object]) -> Plan:
         raise GeneratorError(f"BASE={base!r} is not a link of {spec.urdf}; links: {sorted(links)}")
     chain = _chain(children, base, spec.tip)
     # A HELD linear axis between BASE and TIP (a rail under the arm) is locked where HELD says.
-    kinds = {j.get("name", ""): j.get("type") for j in ET.fromstring(stock).findall("joint")}
+    kinds = {joint.get("name", ""): kind for below in children.values() for _, kind, joint in below}
     for name, _ in spec.held:
         if name in chain and kinds[name] != "prismatic":
             raise GeneratorError(f"HELD={name}: {name} is an arm joint (between BASE and TIP={spec.tip}); of "
@@ -348,17 +347,15 @@ def _plan_robot(spec: RobotSpec, log: Callable[[str], object]) -> Plan:
     lift = analyse_pose(arm, q0, {"home": [(0.0, 0.0, 0.1 * scale)]})
     path, ok = tip_path(arm, q0, (0.0, 0.0, 0.1 * scale))
     home = np.round(path[-1], 4) if ok and lift.reachable else q0
-    efforts = []
+    efforts, linear = [], []
     robot = ET.fromstring(urdf_xml)
     servo_joints = (*arm.joint_names, *(j for j, _ in held))
     for name in servo_joints:
         joint = next(j for j in robot.findall("joint") if j.get("name") == name)
         limit = joint.find("limit")
         efforts.append(float(limit.get("effort", 0.0)) if limit is not None else 0.0)
-    linear = [next(j for j in robot.findall("joint") if j.get("name") == n).get("type") == "prismatic"
-              for n in servo_joints]
-    # The same rule for a prismatic joint, in N/m per N (a rail's 1000 N: 20000 N/m). A stiffer rail (the
-    # tool stiffness of a 0.4 m lever, 125000 N/m) passed free but made a held rail ring: robot_setup README.
+        linear.append(joint.get("type") == "prismatic")
+    # The same rule for a prismatic joint, in N/m per N (a rail's 1000 N: 20000 N/m; robot_setup README).
     kp = tuple(_round(min(KP_MAX, max(KP_MIN, KP_PER_NM * e)), 100.0) if e > 0 else KP_MIN for e in efforts)
     kv = tuple(_round(k * KV_RATIO, 1.0) for k in kp)
     armature = 0.2 if max(efforts) > 100.0 else 0.1
