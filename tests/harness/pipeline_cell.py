@@ -35,13 +35,15 @@ class Cell:
     """One robot package's pipeline and a perfect arm (the commanded joint velocity happens exactly)."""
 
     def __init__(
-        self, robot: str, params: dict | None = None, sensor_error: SensorError | None = None
+        self, robot: str, params: dict | None = None, sensor_error: SensorError | None = None,
+        jog_overrides: dict | None = None,
     ) -> None:
         pkg = SRC / f"{robot}_custom"
         cc = load_settings({**_yaml(SRC / "contact_control/config/contact_control.yaml"),
                             **_yaml(pkg / "config/contact_control.yaml"), **(params or {})})
         self.urdf = ""
-        jog_params = {**_yaml(SRC / "jog_arm/config/jog_arm.yaml"), **_yaml(pkg / "config/jog_arm.yaml")}
+        jog_params = {**_yaml(SRC / "jog_arm/config/jog_arm.yaml"), **_yaml(pkg / "config/jog_arm.yaml"),
+                      **(jog_overrides or {})}
         jog, _ = JogSettings.from_params_with_warnings(jog_params, "/jog_arm_server/")
         urdf = subprocess.run(
             [sys.executable, str(SRC / "control_stack/scripts/make_description"),

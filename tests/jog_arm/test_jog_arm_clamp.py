@@ -47,8 +47,8 @@ def test_while_a_push_is_stopped_the_guard_limit_counts_and_no_force_releases_no
 class HandCell:
     """The UR5's pipeline and a perfect arm whose tool presses a hand (75 N/mm) under it."""
 
-    def __init__(self, robot: str, pressed: float) -> None:
-        self.cell = c = Cell(robot)
+    def __init__(self, robot: str, pressed: float, jog: dict | None = None) -> None:
+        self.cell = c = Cell(robot, jog_overrides=jog)
         for _ in range(150):  # zeroed on the tool's weight
             c.step((0.0, 0.0, 0.0))
         assert c.pipeline.contact.ctrl.last_result.safety == 0
@@ -122,3 +122,17 @@ def test_a_push_into_the_hand_that_overshoots_the_guard_is_released_though_the_p
     hand.run(0.2)  # let go
     hand.run(1.2, twist=(0.0, 0.0, -0.01, 0.0, 0.0, 0.0))  # pressed again, slowly: the guard's press
     assert 2.0 < hand.forces[-1] < 20.0
+
+
+def test_a_push_stopped_at_the_contact_brakes_at_the_contact_stop_scale():
+    """The same held jog into the hand with the contact stop's braking (5 x the joints' 3 rad/s^2) and
+    without it (1 x): the harder stop pins the hand with far less force."""
+    peaks = {}
+    for scale in (1.0, 5.0):
+        hand = HandCell("ur5", pressed=-0.002, jog={"contact_stop_scale": scale})
+        hand.run(0.3, twist=(0.0, 0.0, -0.1, 0.0, 0.0, 0.0))
+        peaks[scale] = max(hand.forces)
+    print(f"\nUR5 jog at 0.1 m/s into the hand: peak {peaks[1.0]:.0f} N braking at 1 x, "
+          f"{peaks[5.0]:.0f} N at 5 x")
+    assert peaks[5.0] < 0.6 * peaks[1.0]
+    assert peaks[5.0] < 140.0  # under the hand's quasi-static limit

@@ -106,6 +106,15 @@ def test_acceleration_limit_scales_the_change_as_a_whole() -> None:
     assert not limited and out == [0.35, 0.25]
 
 
+def test_a_brake_changes_velocity_at_the_brake_scale() -> None:
+    lim = JointLimiter([-1.0, -2.0], [1.0, 2.0], [1.0, 2.0], [10.0, 10.0], margin=0.1, slowdown_width=0.2,
+                       period=0.01, brake_scale=4.0)
+    out, _, _ = lim.limit([0.0, 0.0], [0.0, 0.0], [1.0, 0.5], settle=True)
+    np.testing.assert_allclose(out, [0.9, 0.45])  # 0.1 rad/s per cycle
+    out, _, _ = lim.limit([0.0, 0.0], [0.0, 0.0], [1.0, 0.5], settle=True, brake=True)
+    np.testing.assert_allclose(out, [0.6, 0.3])  # four times that, the direction kept
+
+
 def test_step_guard_never_crosses_a_stop() -> None:
     lim = limiter()
     assert lim.step_scale([0.899, 0.0], [1.0, 1.0]) == pytest.approx(0.1)  # 0.001 rad left, 0.01 step

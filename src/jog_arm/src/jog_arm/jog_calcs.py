@@ -150,7 +150,10 @@ class JogCalcs:
             [settings.prismatic_slowdown_width if linear else settings.joint_limit_slowdown_width
              for linear in self.model.prismatic],
             settings.pub_period,
+            settings.contact_stop_scale,
         )
+        #: Set by the stage while a contact stops the arm: the limiter brakes at contact_stop_scale.
+        self.braking = False
         self._filter = LowPassFilter(settings.low_pass_filter_coeff, 6)  # on the twist
         self._x_filtered = np.zeros(6)
         self._from_commanded = settings.integrate_from == "commanded"
@@ -325,7 +328,7 @@ class JogCalcs:
         else:
             dq, condition, s_sing = self._no_follow(q_ref)
         # 6. Position, velocity and acceleration limits.
-        dq_new, s_pos, s_vel = self.limiter.limit(q_ref, dq, self._dq_out, not follow)
+        dq_new, s_pos, s_vel = self.limiter.limit(q_ref, dq, self._dq_out, not follow, self.braking)
         self._dq_out = dq_new
         # 7. Integrate over the publish period.
         q_cmd = self._q_cmd = self._integrate(q_ref, dq_new)

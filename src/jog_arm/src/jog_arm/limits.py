@@ -58,6 +58,8 @@ class JointLimiter:
             limit falls linearly from the velocity limit to zero (0 = no ramp, braking only); one for all
             joints or one per joint.
         period: Control period [s].
+        brake_scale: The multiple of `max_acceleration` a stop asked for with `limit(..., brake=True)` may
+            decelerate at.
     """
 
     def __init__(
@@ -69,6 +71,7 @@ class JointLimiter:
         margin: float | Sequence[float],
         slowdown_width: float | Sequence[float],
         period: float,
+        brake_scale: float = 1.0,
     ) -> None:
         self.lower_stop = np.asarray(lower, dtype=float) + np.asarray(margin, dtype=float)
         self.upper_stop = np.asarray(upper, dtype=float) - np.asarray(margin, dtype=float)
@@ -79,6 +82,7 @@ class JointLimiter:
         self._hi = self.upper_stop.tolist()
         self._inv_v = (1.0 / self.max_velocity).tolist()
         self._step = (self.max_acceleration * self.period).tolist()  # largest velocity change per cycle
+        self._brake_step = (self.max_acceleration * self.period * brake_scale).tolist()
         self._two_a = (2.0 * self.max_acceleration).tolist()
         width = np.broadcast_to(np.asarray(slowdown_width, dtype=float), self.max_velocity.shape)
         self._ramp = [float(v / w) if w > 0.0 else math.inf
@@ -134,7 +138,7 @@ class JointLimiter:
         return 1.0 if worst <= 1.0 else 1.0 / worst
 
     def limit_acceleration(
-        self, previous: Sequence[float], target: Sequence[float]
+        self, previous: Sequence[float], target: Sequence[float], brake: bool = False
     ) -> tuple[list[float], bool]:
         """Moves from `previous` toward `target` by the largest step within the acceleration limits.
 
@@ -143,12 +147,13 @@ class JointLimiter:
         Args:
             previous: Last output velocities [rad/s].
             target: Wanted velocities [rad/s].
+            brake: A stop: the limits times `brake_scale`.
 
         Returns:
             The new velocities and whether the step was limited.
         """
         k = 1.0
-        for p, t, step in zip(previous, target, self._step, strict=True):
+        for p, t, step in zip(previous, target, self._brake_step if brake else self._step, strict=True):
             change = abs(t - p)
             if change * k > step:
                 k = step / change
@@ -157,7 +162,8 @@ class JointLimiter:
         return [p + k * (t - p) for p, t in zip(previous, target, strict=True)], True
 
     def limit(
-        self, q: Sequence[float], dq: list[float], previous: Sequence[float], settle: bool
+        self, q: Sequence[float], dq: list[float], previous: Sequence[float], settle: bool,
+        brake: bool = False,
     ) -> tuple[list[float], float, float]:
         """Position, velocity, then acceleration limits for `dq` from `q`, each scaling the whole vector.
 
@@ -167,6 +173,7 @@ class JointLimiter:
             previous: Last output velocities [rad/s].
             settle: Nothing is being followed: a result within 1e-9 rad/s of rest is made exactly zero, so
                 the stop ends.
+            brake: A stop (a contact): decelerate at `brake_scale` times the acceleration limits.
 
         Returns:
             The new velocities (a new list), the position scale and the velocity scale.
@@ -176,7 +183,7 @@ class JointLimiter:
         scale = s_pos * s_vel
         if scale < 1.0:
             dq = [v * scale for v in dq]
-        dq_new, limited = self.limit_acceleration(previous, dq)
+        dq_new, limited = self.limit_acceleration(previous, dq, brake)
         if limited:  # slowing down slower than asked might cross a stop: position beats acceleration
             guard = self.step_scale(q, dq_new)
             if guard < 1.0:

@@ -241,6 +241,11 @@ class JogSettings:
         "[clamping](#clamping)); shorter peaks (a strike) are not",
     )
     clamp_release_speed: float = _pos(0.02, "m/s", "a clamp is released backing off along the force at this")
+    contact_stop_scale: float = param(
+        5.0, ge=1.0,
+        doc="a push the contact guard stops at its limit, and a clamp, brake at this multiple of the joints' "
+        "acceleration limits (README: [clamping](#clamping)); the driver's own limit still applies",
+    )
     clamp_release_force: float = _pos(
         3.0, "N", "the release ends below this contact force (under 10 N with room for the force's error)"
     )

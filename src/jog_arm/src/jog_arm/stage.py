@@ -197,6 +197,7 @@ class JogStage:
             self._await_pause = False
         if self.clamp.active:  # releasing a clamp: no command moves the arm until it is released
             return None
+        self.jog.braking = False
         if is_guarded and self.guard is not None:
             twist = self._guarded(twist, frame or self.settings.default_cmd_frame, t)
         result = self.jog.set_command(twist, frame, t)
@@ -240,6 +241,7 @@ class JogStage:
         if result.blocked and result.force >= self.guard.max_force and force is not None and \
                 _pushes_into(twist, force):
             self._push_stopped = t
+            self.jog.braking = True  # a push stopped at the contact: brake as hard as allowed
         if result.message != self._guard_note and result.acted:
             self.notes.append(("warn_throttle", result.message))
         self._guard_note, self._guard_acted = result.message, result.acted
@@ -257,7 +259,7 @@ class JogStage:
             retreat = clamp.check(raw, t - measured, self.settings.contact_guard_timeout, t, pushed)
         if retreat is None:
             if was:
-                clamp.active = False
+                clamp.active = self.jog.braking = False
                 self.jog.drop_command(f"clamp released (peak {clamp.peak:.0f} N)")
                 self._await_pause = True
                 self._fault_note = (f"clamp released below {clamp.release:g} N (peak {clamp.peak:.0f} N); "
@@ -281,6 +283,7 @@ class JogStage:
             self.notes.append(("warn", f"clamp: {clamp.peak:.0f} N, over {crossed} for {clamp.hold:g} s: "
                                "backing off along the force"))
         self._away = v
+        self.jog.braking = True
         unit = s.scale_linear if s.command_in_type == "unitless" else 1.0  # m/s either way
         self.jog.set_command((v[0] / unit, v[1] / unit, v[2] / unit, 0.0, 0.0, 0.0), root, t)
         self._from_topic = False

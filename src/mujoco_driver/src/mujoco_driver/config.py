@@ -169,13 +169,20 @@ class Hole:
 class Hand:
     """A person's hand lying on the obstacle block (README, Fixtures): a box of ISO/TS 15066's hand mass on a
     vertical slide joint whose spring is the hand's tissue (Annex A: 0.6 kg, 75 N/mm), backed by the block:
-    pressed more than `travel` it is on the bone (the joint's limit)."""
+    pressed more than `travel` it is on the bone (the joint's limit). `free`: the hand held in the air `at`
+    a point instead, ISO/TS 15066's transient contact: the 0.6 kg moves away when struck, the tissue is the
+    contact's stiffness (75 N/mm against a tool much heavier than the hand) and a weak spring is the arm
+    that holds it."""
 
     mass: float = 0.6  # [kg] ISO/TS 15066 Table A.3
     stiffness: float = 75e3  # [N/m] ISO/TS 15066 Table A.3 (75 N/mm)
     size: tuple[float, float, float] = (0.09, 0.09, 0.03)  # [m] a palm (a guess at a hand's size)
     travel: float = 0.015  # [m] tissue compression before bone (a guess: 1125 N at 75 N/mm)
     damping_ratio: float = 0.2  # of the spring-mass (a guess: tissue is well damped)
+    free: bool = False  # fixture free_hand: held in the air, nothing under it (a strike)
+    at: tuple[float, float, float] = (0.0, 0.0, 0.0)  # [m] free hand: the centre of its underside
+    hold_stiffness: float = 1e3  # [N/m] free hand: the arm holding it up, critically damped (a guess)
+    reach: float = 0.1  # [m] free hand: how far a strike may push it down (its slide's range)
 
 
 @dataclass(frozen=True)
@@ -201,6 +208,8 @@ class ServoConfig:
         armature: Reflected rotor inertia added to each joint [kg m^2] (real geared drives have it; it also
             keeps stiff servos stable at the timestep).
         max_acceleration: Setpoint acceleration limit in every command mode [rad/s^2 or m/s^2].
+        max_deceleration: The limit while a joint slows down in velocity and trajectory modes, as a
+            robot controller's stop (None: max_acceleration).
         payload_feedforward: Add the torque that holds the tool's weight (like a robot controller's payload
             setting), so the arm does not sag under it; the sensor still measures the weight.
     """
@@ -210,6 +219,7 @@ class ServoConfig:
     armature: PerJoint
     max_acceleration: PerJoint
     payload_feedforward: bool = True
+    max_deceleration: PerJoint | None = None
 
 
 @dataclass(frozen=True)
@@ -289,7 +299,8 @@ class SceneConfig:
             )
         if "start_pose" not in data:
             raise ConfigError("start_pose: missing (joint name -> angle [rad])")
-        servo = _section(data, "servo", ("kp", "kv", "armature", "max_acceleration", "payload_feedforward"))
+        servo = _section(data, "servo", ("kp", "kv", "armature", "max_acceleration", "max_deceleration",
+                                           "payload_feedforward"))
         for key in ("kp", "kv"):
             if key not in servo:
                 raise ConfigError(f"servo.{key}: missing")
@@ -314,6 +325,8 @@ class SceneConfig:
                 max_acceleration=PerJoint.parse(servo.get("max_acceleration", 10.0), "servo.max_acceleration",
                                                 0.0, strict_low=True),
                 payload_feedforward=feedforward,
+                max_deceleration=None if servo.get("max_deceleration") is None else PerJoint.parse(
+                    servo["max_deceleration"], "servo.max_deceleration", 0.0, strict_low=True),
             ),
             timestep=timestep,
             integrator=integrator,

@@ -1,18 +1,19 @@
-"""Fixtures on the obstacle block: a plate with a square, chamfered hole, built from boxes (MuJoCo collides
-meshes by their convex hull, which would fill the hole). No MuJoCo here: the boxes are data that
-`scene._add_environment` turns into geoms, so the geometry is tested on its own (README, Fixtures).
+"""Fixtures on the obstacle block: a plate with a square, chamfered hole, built from boxes (MuJoCo
+collides meshes by their convex hull, which would fill the hole); the free hand in the block's place. No
+MuJoCo here: the boxes are data that `scene._add_environment` turns into geoms, so the geometry is tested
+on its own (README, Fixtures).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from mujoco_driver.config import Box, Hole
+from mujoco_driver.config import Box, Hand, Hole
 
-__all__ = ["FixtureBox", "hole_boxes", "hole_offset", "hole_pose"]
+__all__ = ["FixtureBox", "free_hand", "hole_boxes", "hole_offset", "hole_pose"]
 
 
 @dataclass(frozen=True)
@@ -23,6 +24,13 @@ class FixtureBox:
     half: tuple[float, float, float]
     pos: tuple[float, float, float]
     quat: tuple[float, float, float, float]
+
+
+def free_hand(block: Box) -> Hand:
+    """The free hand (config.Hand `free`) with its top where `block`'s top centre is."""
+    hand = Hand(free=True)
+    x, y, z = block.position
+    return replace(hand, at=(x, y, z + block.size[2] / 2.0 - hand.size[2]))
 
 
 def hole_offset(seed: int, spread: float, yaw_spread: float) -> tuple[float, float, float]:

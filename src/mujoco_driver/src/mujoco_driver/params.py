@@ -17,7 +17,7 @@ from compliant_common.errors import StackError
 from compliant_common.schema import Param, SchemaError, param, schema_of
 
 from mujoco_driver.config import Hand, Hole, PerJoint, SceneConfig, Surface, load_scene_config
-from mujoco_driver.fixtures import hole_offset
+from mujoco_driver.fixtures import free_hand, hole_offset
 
 __all__ = ["PARAMETERS", "DriverParamError", "DriverSettings", "load_scene", "urdf_root_link"]
 
@@ -78,10 +78,11 @@ class DriverSettings:
         0.01, unit="s", ge=0.0, doc="period of `~eef_pose` (ground truth for plots); 0 = with `joint_states`"
     )
     fixture: str = param(
-        "none", choices=("none", "clear", "hole", "hand", "tilted", "cylinder", "sphere"),
+        "none", choices=("none", "clear", "hole", "hand", "free_hand", "tilted", "cylinder", "sphere"),
         doc="clear: no block (a cell's arms meeting over the tables); hole: a plate with a square, chamfered "
         "hole on the obstacle block, for a square peg tool; hand: "
-        "a person's hand (ISO/TS 15066: 0.6 kg, 75 N/mm) lying on the block; tilted: the block turned by "
+        "a person's hand (ISO/TS 15066: 0.6 kg, 75 N/mm) lying on the block; free_hand: that hand held in "
+        "the air in the block's place, free to move when struck; tilted: the block turned by "
         "`surface_tilt` about the base's y axis, a sloping top; cylinder (axis along y), sphere: a curved "
         "part in the block's place, its top at the block's top centre (README, Fixtures)",
     )
@@ -322,4 +323,9 @@ def load_scene(settings: DriverSettings) -> SceneConfig:
         if cfg.obstacle is None:
             raise DriverParamError("~fixture hand: the scene has no obstacle block to lay the hand on")
         cfg = dataclasses.replace(cfg, hand=Hand())
+    if settings.fixture == "free_hand":
+        if cfg.obstacle is None:
+            raise DriverParamError("~fixture free_hand: the scene has no obstacle block to put the hand in "
+                                   "place of")
+        cfg = dataclasses.replace(cfg, obstacle=None, hand=free_hand(cfg.obstacle))
     return cfg

@@ -208,6 +208,7 @@ class SceneModel:
         upper: Upper position limits.
         velocity_limit: Velocity limits from the URDF [rad/s or m/s] (inf when absent).
         max_acceleration: Setpoint acceleration limits from the scene settings [rad/s^2 or m/s^2].
+        max_deceleration: Their limits while slowing down (config.ServoConfig).
         start_pose: Start joint positions.
         ft_site: Site id at the F/T sensor frame.
         force_adr: sensordata address of the force sensor (3 values).
@@ -230,6 +231,7 @@ class SceneModel:
     upper: np.ndarray
     velocity_limit: np.ndarray
     max_acceleration: np.ndarray
+    max_deceleration: np.ndarray
     start_pose: np.ndarray
     ft_site: int
     force_adr: int
@@ -283,8 +285,10 @@ def _add_environment(spec: mujoco.MjSpec, cfg: SceneConfig) -> None:
                 part = world.add_geom(name=box.name, type=mujoco.mjtGeom.mjGEOM_BOX, size=list(box.half),
                                       pos=list(box.pos), quat=list(box.quat), rgba=[0.7, 0.7, 0.75, 1.0])
                 part.solimp = OBSTACLE_SOLIMP
-        if cfg.hand is not None:
+        if cfg.hand is not None and not cfg.hand.free:
             _add_hand(spec, obs, cfg.hand)
+    if cfg.hand is not None and cfg.hand.free:
+        _add_free_hand(spec, cfg.hand)
 
 
 def _add_curved(world: mujoco.MjsBody, block: Box, surface: Surface) -> mujoco.MjsGeom:
@@ -336,6 +340,26 @@ def _add_hand(spec: mujoco.MjSpec, block: Box, hand: Hand) -> None:
     spec.add_exclude(bodyname1="world", bodyname2=HAND_BODY)  # it sinks into the block as it is pressed
 
 
+def _add_free_hand(spec: mujoco.MjSpec, hand: Hand) -> None:
+    """The hand held in the air (config.Hand, `free`), weightless (gravcomp)."""
+    x, y, z = hand.at
+    body = spec.worldbody.add_body(name=HAND_BODY, pos=[x, y, z + hand.size[2] / 2.0])
+    body.gravcomp = 1.0
+    body.add_joint(name=HAND_JOINT, type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0.0, 0.0, 1.0],
+                   stiffness=hand.hold_stiffness, springref=0.0, range=[-hand.reach, 0.05],
+                   limited=mujoco.mjtLimited.mjLIMITED_TRUE,
+                   damping=2.0 * math.sqrt(hand.hold_stiffness * hand.mass))
+    geom = body.add_geom(name=HAND_BODY, type=mujoco.mjtGeom.mjGEOM_BOX, size=[a / 2.0 for a in hand.size],
+                         mass=hand.mass, rgba=[0.9, 0.7, 0.55, 1.0])
+    # The tissue is the contact: MuJoCo's direct solref is a reference acceleration per metre of penetration
+    # (and per m/s), k / m_H the hand's own, so the contact is k against a tool much heavier than the hand.
+    omega2 = hand.stiffness / hand.mass
+    geom.solref = [-omega2, -2.0 * hand.damping_ratio * math.sqrt(omega2)]
+    geom.solimp = [0.99, 0.99, 0.001, 0.5, 2.0]
+    geom.priority = 2  # its solref and solimp make the contact's
+    spec.add_exclude(bodyname1="world", bodyname2=HAND_BODY)
+
+
 OVERLAP_SAMPLES = 8  # postures (the start pose and fixed pseudo-random ones) a pair must touch in all of
 
 
@@ -385,6 +409,7 @@ class ArmSpec:
     arm_names: list[str]
     start: np.ndarray
     max_acceleration: np.ndarray
+    max_deceleration: np.ndarray
     velocity: list[float | None]
     geometry: list[LinkGeometry]
 
@@ -458,6 +483,8 @@ def arm_spec(urdf_xml: str, cfg: SceneConfig, mesh_cache: str | None = None) -> 
         arm_start = dict(zip(arm_names, cfg.start_pose.resolve(arm_names), strict=True))
         start = np.array([arm_start[n] if n in arm_start else cfg.held_joints[n] for n in names])
         max_acceleration = np.array(cfg.servo.max_acceleration.resolve(names))
+        braking = cfg.servo.max_deceleration
+        max_deceleration = max_acceleration if braking is None else np.array(braking.resolve(names))
     except ValueError as exc:
         held = (f" (held joints: {sorted(cfg.held_joints)})" if cfg.held_joints else
                 " (joints outside the arm go in held_joints: name -> position)")
@@ -498,7 +525,8 @@ def arm_spec(urdf_xml: str, cfg: SceneConfig, mesh_cache: str | None = None) -> 
     except ValueError as exc:
         raise SceneError(f"MuJoCo cannot compile the scene: {exc}") from exc
     vel = [limits[n].velocity if n in limits and limits[n].velocity else np.inf for n in names]
-    return ArmSpec(spec, model, cfg, names, arm_names, start, max_acceleration, vel, geometry)
+    return ArmSpec(spec, model, cfg, names, arm_names, start, max_acceleration, max_deceleration, vel,
+                   geometry)
 
 
 def index_scene(model: mujoco.MjModel, arm: ArmSpec, prefix: str = "") -> SceneModel:
@@ -527,6 +555,7 @@ def index_scene(model: mujoco.MjModel, arm: ArmSpec, prefix: str = "") -> SceneM
         upper=upper,
         velocity_limit=np.array(arm.velocity, dtype=float),
         max_acceleration=arm.max_acceleration,
+        max_deceleration=arm.max_deceleration,
         start_pose=arm.start,
         ft_site=model.site(prefix + FT_SITE).id,
         force_adr=int(model.sensor_adr[model.sensor(prefix + FORCE_SENSOR).id]),

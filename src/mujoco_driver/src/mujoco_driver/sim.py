@@ -142,6 +142,11 @@ class Simulation:
         self._two_accel = 2.0 * sc.max_acceleration
         self._max_accel = sc.max_acceleration
         self._max_dv = self._max_accel * self.dt
+        self._brake_dv = sc.max_deceleration * self.dt
+        self._brakes = bool(np.any(sc.max_deceleration != sc.max_acceleration))
+        self._dv_limit = self._max_dv.copy()
+        self._slowing, self._not_past = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+        self._speed = np.zeros(n)
         self._jacp = np.zeros((3, self.model.nv))
         self._payload_force = -sc.payload_mass * self.model.opt.gravity
         self._ff = np.zeros(self.model.nv)
@@ -467,7 +472,8 @@ class Simulation:
         In every mode the setpoint's velocity stays within the velocity limits and changes by at most
         ``max_acceleration * dt`` per step, as a robot controller's rate limiter does: a late or jumping
         command then gives a bounded acceleration (and a bounded inertial force on the wrist sensor)
-        instead of a spike.
+        instead of a spike. In velocity and trajectory modes a joint slowing down may change by
+        ``max_deceleration * dt``: a stop brakes as the robot can.
         Position mode: a velocity- and acceleration-limited profile to the goal (brakes in time to stop).
         Velocity mode: the commanded velocity, reached with the acceleration limit, integrated.
         Trajectory mode: the interpolated velocity plus a correction towards the interpolated position
@@ -500,9 +506,20 @@ class Simulation:
         else:
             # Scale the velocity change as a whole, so that a catch-up keeps the direction of motion (and the
             # tool its Cartesian path) instead of the joints with the most to do lagging behind.
+            limit = self._dv_limit
+            if self._brakes:  # a joint slowing down (toward rest, not past it) may change at max_deceleration
+                slowing, not_past, speed, scratch = self._slowing, self._not_past, self._speed, self._scratch
+                np.multiply(vel, qd_t, out=scratch)
+                np.greater_equal(scratch, 0.0, out=not_past)
+                np.abs(vel, out=scratch)
+                np.abs(qd_t, out=speed)
+                np.less(scratch, speed, out=slowing)
+                np.logical_and(slowing, not_past, out=slowing)
+                np.copyto(limit, self._max_dv)
+                np.copyto(limit, self._brake_dv, where=slowing)
             np.subtract(vel, qd_t, out=vel)
             np.abs(vel, out=self._scratch)
-            self._scratch /= self._max_dv
+            self._scratch /= limit
             ratio = float(self._scratch.max())
             if ratio > 1.0:
                 vel /= ratio

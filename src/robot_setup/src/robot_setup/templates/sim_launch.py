@@ -30,7 +30,7 @@ def sim_launch(plan: Plan) -> str:
   <arg name="single_process" default="true" doc="contact_control and jog_arm in one process (control_stack_node), one hop less"/>
   <arg name="with_driver" default="true" doc="false: no driver of its own, only its parameters (a cell's one world simulates this robot: mujoco_driver README, Cells)"/>
   <arg name="publish_synchronously" default="true" doc="the driver writes subscribers' sockets in its loop"/>
-  <arg name="fixture" default="none" doc="clear: no block; hole: a plate with a square, chamfered hole on the block; hand: a person's hand (ISO/TS 15066) lying on it; tilted: the block's top tilted 15 degrees; cylinder, sphere: a curved part in the block's place (mujoco_driver README, Fixtures)"/>
+  <arg name="fixture" default="none" doc="clear: no block; hole: a plate with a square, chamfered hole on the block; hand: a person's hand (ISO/TS 15066) lying on it; free_hand: that hand held in the air in the block's place; tilted: the block's top tilted 15 degrees; cylinder, sphere: a curved part in the block's place (mujoco_driver README, Fixtures)"/>
   <arg name="hole_offset" default="[0.0, 0.0, 0.0]" doc="the hole's offset from its nominal pose '[dx, dy, yaw]' [m, m, rad]"/>
   <arg name="hole_seed" default="-1" doc="&gt;= 0: the hole's offset drawn from this seed instead (within 4 mm and 2 degrees)"/>
   <arg name="hole_tilt" default="[0.0, 0.0]" doc="the hole's axis tilted '[roll, pitch]' [rad] about its own x, then y axis (at most 0.1)"/>

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import math
 
+from jog_arm.settings import JogSettings
+
 from robot_setup.plan import Plan
 from robot_setup.templates.text import generated_by, joints, num
 
@@ -82,6 +84,7 @@ servo:
 {joints(plan.kv, plan.servo_joints, "{:.1f}", 4)}
   armature: {plan.armature}            # reflected rotor inertia per joint [kg m^2]
   max_acceleration: {plan.acceleration + 1.0:.1f}    # [rad/s^2] setpoint acceleration limit (above jog_arm's {plan.acceleration:g} rad/s^2)
+  max_deceleration: {plan.acceleration * JogSettings.contact_stop_scale + 1.0:.1f}   # [rad/s^2] while slowing down (above jog_arm's contact stop, {JogSettings.contact_stop_scale:g} x {plan.acceleration:g}; a guess at what the arm can)
   payload_feedforward: true
 
 wrench_noise:              # Gaussian sensor noise (0: exact)
