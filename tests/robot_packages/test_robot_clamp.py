@@ -3,7 +3,7 @@ down onto it from an outside source (the keyboard's path), held, overshoots the 
 hand, below the hand's quasi-static 140 N (the contact stop brakes hard); jog_arm releases the clamp below
 10 N within a second of the peak, says so, and the held key moves nothing more until it is let go of.
 
-The UR5 runs the default single process, the Panda the two-node layout (the force over a topic)."""
+The robots: harness.hand_scene."""
 
 from __future__ import annotations
 
@@ -14,23 +14,19 @@ pytest.importorskip("compliant_control_msgs.msg", reason="needs devel/setup.bash
 
 from compliant_control_msgs.msg import JogStatus
 from geometry_msgs.msg import TwistStamped, WrenchStamped
-from harness.launch import run_launch
+from harness.hand_scene import BASE_FRAME, LAYOUTS, hand_scene
 from harness.waiting import Collector, wait_until
 
 pytestmark = pytest.mark.cobot_safety
 
-BASE_FRAME = {"ur5_custom": "base_link", "panda_custom": "panda_link0"}
 SPEED = 0.1  # [m/s] a keyboard's jog down onto the hand
 HAND_LIMIT = 140.0  # [N] ISO/TS 15066 Annex A, hand, quasi-static
 
 
-@pytest.mark.parametrize("robot, single_process", [("ur5_custom", True), ("panda_custom", False)])
+@pytest.mark.parametrize("robot, single_process", LAYOUTS)
 def test_a_hand_pinned_by_a_jog_is_released_below_10_newtons_within_a_second(ros_node, robot, single_process):
     rospy = ros_node
-    args = {"single_process": str(single_process).lower(), "fixture": "hand"}
-    with run_launch(robot, "sim.launch", args=args) as h:
-        for topic in ("/mujoco_driver/eef_pose", "/wrench", "/jog_arm_server/status"):
-            h.wait_for_topic(topic, timeout=40)
+    with hand_scene(robot, single_process, "hand") as h:
         h.wait_for_service("/contact_control_node/tare", timeout=40)
         wrench = Collector("/wrench", WrenchStamped, queue_size=20000)
         status = Collector("/jog_arm_server/status", JogStatus, queue_size=20000)

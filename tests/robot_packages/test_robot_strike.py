@@ -5,7 +5,7 @@ transient limit.
 
 For the hand the cap is above 0.5 m/s whatever the arm (280 N / sqrt(0.6 kg 75 N/mm) = 1.32 m/s for an
 infinitely heavy one), so the jog goes at 0.5 m/s; for the face (65 N, 4.4 kg) it binds, and the same jog
-goes at the cap. The UR5 runs the default single process, the Panda the two-node layout."""
+goes at the cap. The robots: harness.hand_scene."""
 
 from __future__ import annotations
 
@@ -16,13 +16,12 @@ pytest.importorskip("compliant_control_msgs.msg", reason="needs devel/setup.bash
 
 from compliant_control_msgs.msg import JogStatus
 from geometry_msgs.msg import PoseStamped, TwistStamped, WrenchStamped
-from harness.launch import run_launch
+from harness.hand_scene import BASE_FRAME, LAYOUTS, hand_scene
 from harness.waiting import Collector, wait_until
 from jog_arm.body_regions import region_named
 
 pytestmark = pytest.mark.cobot_safety
 
-BASE_FRAME = {"ur5_custom": "base_link", "panda_custom": "panda_link0"}
 REQUESTED = 0.5  # [m/s] the jog down onto the hand
 RISE = 0.25  # [m] the tool is first raised this far: room to reach the speed
 TOUCH = 20.0  # [N] the contact begins (the contact guard's stop)
@@ -97,20 +96,18 @@ class Strike:
         return float(np.median(caps)), approach, float(force.max())
 
 
-@pytest.mark.parametrize("robot, single_process", [("ur5_custom", True), ("panda_custom", False)])
+@pytest.mark.parametrize("robot, single_process", LAYOUTS)
 def test_a_strike_on_a_free_hand_is_capped_and_within_the_transient_limit(ros_node, robot, single_process):
     rospy = ros_node
     from dynamic_reconfigure.client import Client
 
-    args = {"single_process": str(single_process).lower(), "fixture": "free_hand"}
-    with run_launch(robot, "sim.launch", args=args) as h:
-        for topic in ("/mujoco_driver/eef_pose", "/wrench", "/jog_arm_server/status"):
-            h.wait_for_topic(topic, timeout=40)
+    with hand_scene(robot, single_process, "free_hand") as h:
         topics = {"wrench": Collector("/wrench", WrenchStamped, queue_size=50000),
                   "status": Collector("/jog_arm_server/status", JogStatus, queue_size=50000),
                   "poses": Collector("/mujoco_driver/eef_pose", PoseStamped, queue_size=50000)}
         pub = rospy.Publisher("/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1, tcp_nodelay=True)
         client = Client("/jog_arm_server", timeout=20)
+        configured = rospy.get_param("/jog_arm_server/collaborative_region")
         report = []
         try:
             for c in topics.values():
@@ -131,6 +128,8 @@ def test_a_strike_on_a_free_hand_is_capped_and_within_the_transient_limit(ros_no
             print(f"\n{robot}: " + "; ".join(report))
             assert caps["face"] < REQUESTED < caps["hand"], "a cap that binds and one that does not"
         finally:
+            # The master outlives this launch: the next test's jog_arm must not find the face here.
+            client.update_configuration({"collaborative_region": configured})
             for c in topics.values():
                 c.close()
             pub.unregister()
