@@ -20,4 +20,8 @@ def hand_scene(robot: str, single_process: bool, fixture: str) -> Iterator[Launc
     with run_launch(robot, "sim.launch", args=args) as h:
         for topic in ("/mujoco_driver/eef_pose", "/wrench", "/jog_arm_server/status"):
             h.wait_for_topic(topic, timeout=40)
-        yield h
+        try:
+            yield h
+        except AssertionError as err:  # a lockstep given up on, a dropped backlog: why a run went wrong
+            err.add_note(f"the launch's warnings:\n{h.warnings()}")
+            raise

@@ -40,6 +40,12 @@ class Launched:
         with open(self._log_path, errors="replace") as log:
             return log.read()
 
+    def warnings(self, last: int = 20) -> str:
+        """The newest `last` lines the processes logged at WARN or above: why a run went wrong."""
+        lines = [line for line in self.output().splitlines()
+                 if any(level in line for level in ("[WARN]", "[ERROR]", "[FATAL]"))]
+        return "\n".join(lines[-last:])
+
     def _master(self) -> xmlrpc.client.ServerProxy:
         return xmlrpc.client.ServerProxy(os.environ["ROS_MASTER_URI"])
 

@@ -3,7 +3,9 @@ holds it for a controller apart, a give-up lets the watchdog stop the arm (simul
 
 from __future__ import annotations
 
+import os
 import pathlib
+import signal
 import subprocess
 import sys
 import time
@@ -117,6 +119,22 @@ def test_a_silent_stack_pauses_a_driven_arm_then_the_watchdog_stops_it(arm):
     t0 = arm.now()
     wait_until(lambda: arm.now() > t0 + 0.5, 10, "the simulation to run on after the give-up")
     assert abs(arm.joints.last().velocity[-1]) < 1e-3, "command_timeout did not stop the arm"
+
+
+def test_a_freeze_of_the_whole_machine_is_not_a_silent_stack(arm):
+    arm.command(0.5, 0.3)
+    _stalled(arm, 0.2)  # the driver holds the simulation, waiting for the stack
+    gave_up = arm.handle.output().count("lockstep: no")
+    os.killpg(arm.handle.proc.pid, signal.SIGSTOP)  # the driver frozen with the stack (this test: silent)
+    try:
+        time.sleep(1.5 * WAIT)
+    finally:
+        os.killpg(arm.handle.proc.pid, signal.SIGCONT)
+    time.sleep(0.1)  # the stack wakes a little later: the driver waits for it, awake, for 0.1 s of WAIT
+    t0 = arm.now()
+    arm.command(0.5, 0.1)
+    wait_until(lambda: arm.now() > t0, 10, "the simulation to go on with the commands")
+    assert arm.handle.output().count("lockstep: no") == gave_up, arm.handle.output()[-2000:]
 
 
 def test_a_zero_command_or_a_trajectory_lets_the_simulation_run(arm):

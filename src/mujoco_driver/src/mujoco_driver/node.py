@@ -165,7 +165,9 @@ class MujocoDriverNode:
         with self._lock:
             for port in ports:
                 port.read_state()
-        waiting_since, current = math.nan, True  # current: this state went out
+        # The wait for a silent stack, in wall time the loop was awake for: a freeze of the whole machine
+        # (every process descheduled at once) counts as one slice, not as the stack's silence.
+        waited, waited_at, current = math.nan, math.nan, True  # current: this state went out
         while not (self._stop_requested or rospy.is_shutdown()):
             now = time.monotonic()
             due = [i for i, state in enumerate(states) if state.due(now)]
@@ -181,9 +183,11 @@ class MujocoDriverNode:
                     current = True
                     self._publish_current()
                     continue
-                if math.isnan(waiting_since):
-                    waiting_since = now
-                if now - waiting_since < s.lockstep_wait:
+                if math.isnan(waited):
+                    waited, waited_at = 0.0, now
+                waited += min(now - waited_at, 2.0 * _LOCKSTEP_SLICE)
+                waited_at = now
+                if waited < s.lockstep_wait:
                     assert port.lockstep is not None
                     slice_ = min(st.sleep_time(now, _LOCKSTEP_SLICE) for st in states)
                     port.lockstep.wait(stepper.time, slice_)
@@ -192,9 +196,9 @@ class MujocoDriverNode:
                     if other.lockstep is not None:
                         other.lockstep.give_up()
                 rospy.logwarn("mujoco_driver: lockstep: no %s for %.2f s (wall time): running on; "
-                              "command_timeout stops the arm", why, now - waiting_since)
-            if not math.isnan(waiting_since):  # a pause is not a backlog: no catching up after it
-                waiting_since = math.nan
+                              "command_timeout stops the arm", why, waited)
+            if not math.isnan(waited):  # a pause is not a backlog: no catching up after it
+                waited = math.nan
                 now = time.monotonic()
                 pacer.start(now)
             wait = pacer.wait_time(now)

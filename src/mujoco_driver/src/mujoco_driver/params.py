@@ -137,8 +137,9 @@ class DriverSettings:
         "controller pauses the simulation instead of letting the arm drive on (README, Lockstep). 0: off",
     )
     lockstep_wait: float = _pos(
-        1.0, "s", "longest wait (wall time) for a silent stack; then the simulation runs on until it speaks "
-        "again, and `command_timeout` stops the arm"
+        1.0, "s", "longest wait (wall time the driver was awake: a freeze of the whole machine is not the "
+        "stack's silence) for a silent stack; then the simulation runs on until it speaks again, and "
+        "`command_timeout` stops the arm"
     )
     lockstep_echo_topic: str = param(
         "",
