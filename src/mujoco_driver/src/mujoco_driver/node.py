@@ -166,7 +166,7 @@ class MujocoDriverNode:
             for port in ports:
                 port.read_state()
         # The wait for a silent stack, in wall time the loop was awake for: a freeze of the whole machine
-        # (every process descheduled at once) counts as one slice, not as the stack's silence.
+        # (every process descheduled at once) counts as two slices at most, not as the stack's silence.
         waited, waited_at, current = math.nan, math.nan, True  # current: this state went out
         while not (self._stop_requested or rospy.is_shutdown()):
             now = time.monotonic()
@@ -195,7 +195,7 @@ class MujocoDriverNode:
                 for other in ports:
                     if other.lockstep is not None:
                         other.lockstep.give_up()
-                rospy.logwarn("mujoco_driver: lockstep: no %s for %.2f s (wall time): running on; "
+                rospy.logwarn("mujoco_driver: lockstep: no %s for %.2f s (wall time awake): running on; "
                               "command_timeout stops the arm", why, waited)
             if not math.isnan(waited):  # a pause is not a backlog: no catching up after it
                 waited = math.nan
