@@ -88,7 +88,7 @@ class TeachSettings:
         0.03, unit="s", ge=0.0,
         doc="the fed-forward velocity is the path's this far ahead: the command path's latency (jogger, "
         "driver, servo), so the tool slows where the path does instead of overshooting (a guess from the "
-        "simulated arms' 20-50 ms)",
+        "simulated arms' 20-50 ms); contact_control's `command_latency` when that is longer",
     )
     replay_lag: float = param(
         0.0015, unit="m", gt=0.0,

@@ -79,6 +79,7 @@ class ReplayServer:
         self._events: list[ContactEvent] = []
         self._lock = threading.Lock()
         self._playback: Playback | None = None
+        self._lead = s.replay_lead  # [s] this replay's (`_arm`)
         self._ref = PathReference(horizon_step=s.replay_horizon_step)
         self._prefix = for_this_node()  # the robot's frames on tf and in messages; programs keep bare names
         self._ref.header.frame_id = self._prefix.add(base_frame)
@@ -224,7 +225,7 @@ class ReplayServer:
         return np.array([p.x, p.y, p.z])
 
     def _send(self, play: Playback) -> None:
-        p, q, v = play.reference(self.s.replay_lead)
+        p, q, v = play.reference(self._lead)
         ref = self._ref
         ref.header.stamp = rospy.Time.now()
         pos, ori = ref.pose.position, ref.pose.orientation
@@ -253,7 +254,8 @@ class ReplayServer:
         if not moved.success:
             raise ReplayError(f"could not move to the start: {moved.message}")
         smoothing = s.replay_press_smoothing if press >= 0 else s.replay_smoothing
-        play = Playback(program, speed, self._limits(), smoothing)
+        limits, self._lead = self._arm()
+        play = Playback(program, speed, limits, smoothing)
         with self._lock:
             self._playback = play
         rate = rospy.Rate(s.replay_rate)
@@ -344,9 +346,11 @@ class ReplayServer:
             if ours:
                 self._stop_move()
 
-    def _limits(self) -> Limits:
+    def _arm(self) -> tuple[Limits, float]:
         """contact_control's velocity and acceleration limits (its parameters read as it reads them) times
-        `replay_limit_fraction`: what the replay's timing is planned against.
+        `replay_limit_fraction`: what the replay's timing is planned against; and the fed-forward twist's
+        lead [s]: `replay_lead`, or contact_control's `command_latency` when that is longer (an arm
+        commanded through a slower path turns a corner that much later).
 
         Raises:
             ReplayError: contact_control's parameters are not valid (it would not have started with them).
@@ -358,9 +362,10 @@ class ReplayServer:
         lin, ang = settings.tuning(False), settings.tuning(True)
         # Slowing down is planned as gently as speeding up: contact_control's deceleration limit (2.5 m/s^2 by
         # default) is more than a simulated UR3 followed (12 mm past the L's corner at 2 x).
-        return Limits(lin.max_velocity, lin.acceleration, min(lin.deceleration, lin.acceleration),
-                      ang.max_velocity, ang.acceleration, min(ang.deceleration, ang.acceleration),
-                      ).scaled(self.s.replay_limit_fraction)
+        limits = Limits(lin.max_velocity, lin.acceleration, min(lin.deceleration, lin.acceleration),
+                        ang.max_velocity, ang.acceleration, min(ang.deceleration, ang.acceleration),
+                        ).scaled(self.s.replay_limit_fraction)
+        return limits, max(self.s.replay_lead, settings.command_latency)
 
     def _keep_up(self, play: Playback, tool: np.ndarray | None, keep: list[int]) -> float:
         """How fast the program's clock runs now (1: the requested speed). It slows while the tool is more
