@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import math
 import os
+import re
+import time
 
 import numpy as np
 import pytest
@@ -19,6 +21,7 @@ import tf2_ros
 from compliant_control_msgs.msg import ContactEvent, ReplayProgramAction, ReplayProgramGoal
 from compliant_control_msgs.srv import PushEEF, PushEEFRequest
 from harness.launch import run_launch
+from harness.process import node_pid, stalled
 from harness.waiting import wait_until
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
@@ -41,6 +44,45 @@ def l_program(name: str, robot: str, joints: JointState, frames: tuple[str, str]
         waypoints.append(Waypoint(float(t), tuple(joints.position), p, tuple(quat), keyframe=t in (0.0, t1)))
     return Program(name=name, robot=robot, joint_names=tuple(joints.name), base_frame=frames[0],
                    tip_frame=frames[1], waypoints=tuple(waypoints), samples=len(waypoints))
+
+
+def _start_of_the_l(rospy, robot: str, folder) -> None:
+    """The L saved as `l_path`, starting where the tool is."""
+    buffer = tf2_ros.Buffer()
+    listener = tf2_ros.TransformListener(buffer)  # noqa: F841 (fills the buffer)
+    base, tip = TIP[robot]
+    wait_until(lambda: buffer.can_transform(base, tip, rospy.Time(0)), 20, "the tool's tf")
+    tf = buffer.lookup_transform(base, tip, rospy.Time(0)).transform
+    start = (tf.translation.x, tf.translation.y, tf.translation.z)
+    quat = (tf.rotation.x, tf.rotation.y, tf.rotation.z, tf.rotation.w)
+    joints = rospy.wait_for_message("/joint_states", JointState, timeout=10)
+    ProgramStore(str(folder)).save(l_program("l_path", ROBOT[robot], joints, (base, tip), start, quat))
+
+
+def test_a_stalled_replay_keeps_the_tool_on_the_l_and_its_result_says_it_ran_late(ros_node, tmp_path):
+    """program_server is stopped (SIGSTOP, as a busy machine deschedules it) for 0.3 s near the L's corner of
+    a 2 x replay: contact_control follows the reference's horizon meanwhile, so the tool stays within 5 mm of
+    the path, and the result says how late the replay's loop ran."""
+    rospy = ros_node
+    home = tmp_path / "home"
+    with run_launch("ur5_custom", "sim.launch", env={**os.environ, "HOME": str(home)}) as h:
+        h.wait_for_service("/named_poses/move_to_joints", timeout=40)
+        h.wait_for_service("/teach/pause", timeout=40)
+        client = actionlib.SimpleActionClient("/teach/replay", ReplayProgramAction)
+        assert client.wait_for_server(rospy.Duration(20.0))
+        _start_of_the_l(rospy, "ur5_custom", home / ".ros" / "compliant_programs")
+        feedback = []
+        client.send_goal(ReplayProgramGoal(name="l_path", speed=2.0), feedback_cb=feedback.append)
+        wait_until(lambda: feedback and feedback[-1].progress > 0.6, 30, "the replay near the L's corner")
+        with stalled(node_pid("/teach")):
+            time.sleep(0.3)
+        assert client.wait_for_result(rospy.Duration(60.0)), "the replay to end"
+        result = client.get_result()
+        print(f"\nstalled 0.3 s at 2x: {result.message}")
+        assert result.success and result.path_error_max < 0.005, result.message
+        late = re.search(r"this node's loop ran late \(up to (\d+\.\d+) s between cycles\)", result.message)
+        assert late and float(late.group(1)) >= 0.25, result.message
+        h.stop()
 
 
 # Both arms alone (after the parallel suite): the reference streams from teach, which the simulation does not

@@ -13,6 +13,10 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 pytestmark = [pytest.mark.e2e, pytest.mark.cell]  # scripts/demo_cell runs the simulation
 
 
+# Alone (after the parallel suite): two arms in one world is the suite's heaviest simulation (real-time
+# factor 0.88 with nothing beside it, docs/measurements.md), and beside another worker the UR5's 2 x replay
+# once ended 5.57 mm off its path (cause not found; the failed arm's details now print).
+@pytest.mark.alone
 def test_both_arms_of_the_cell_pass_their_demonstrations_at_the_same_time(tmp_path):
     command = [str(ROOT / "scripts/with_env"), "python", str(ROOT / "scripts/demo_cell"), "--cell",
                "ur5_panda", "--only", "spring_x", "teach_and_replay", "--output", str(tmp_path)]
@@ -23,6 +27,7 @@ def test_both_arms_of_the_cell_pass_their_demonstrations_at_the_same_time(tmp_pa
     for arm in ("left", "right"):
         assert f"[{arm}] [PASS] spring_x" in run.stdout and f"[{arm}] [PASS] teach_and_replay" in run.stdout
         assert (tmp_path / arm / "report.md").exists() and (tmp_path / arm / "spring_x.png").exists()
+        assert "[PASS] teach_and_replay" in (tmp_path / arm / "demos.log").read_text()
         program = tmp_path / "ros_home" / "compliant_programs" / arm / "thesis_demos_teach_and_replay.yaml"
         assert program.exists()
     assert "all demonstrations passed on every arm" in run.stdout

@@ -54,6 +54,23 @@ FEEDBACK_EVERY = 10  # reference cycles per feedback message (10 Hz at 100 Hz)
 _TF_ERRORS = (tf2_ros.LookupException, tf2_ros.ConnectivityException, tf2_ros.ExtrapolationException)
 
 
+class _Late:
+    """The worst lateness of one replay, said with its result: a path error on a loaded machine then shows
+    whether this node's loop stalled or the tool's pose it judged by was old."""
+
+    def __init__(self) -> None:
+        self.gap = self.age = 0.0  # [s] the longest time between two cycles; the oldest tool pose used
+        self.farthest, self.at = -1.0, math.nan  # [m] the tool's largest distance off the path; its progress
+
+    def said(self, period: float) -> str:
+        parts = []
+        if self.gap > 2.5 * period:
+            parts.append(f"this node's loop ran late (up to {self.gap:.2f} s between cycles)")
+        if self.age > 0.05:
+            parts.append(f"the tool's pose was up to {self.age:.2f} s old")
+        return "; " + " and ".join(parts) if parts else ""
+
+
 class ReplayError(StackError):
     """The replay cannot start or go on; the message is the action's result message."""
 
@@ -80,6 +97,7 @@ class ReplayServer:
         self._lock = threading.Lock()
         self._playback: Playback | None = None
         self._lead = s.replay_lead  # [s] this replay's (`_arm`)
+        self._late = _Late()
         self._ref = PathReference(horizon_step=s.replay_horizon_step)
         self._prefix = for_this_node()  # the robot's frames on tf and in messages; programs keep bare names
         self._ref.header.frame_id = self._prefix.add(base_frame)
@@ -221,6 +239,9 @@ class ReplayServer:
                                            rospy.Time(0))
         except _TF_ERRORS:
             return None
+        stamp = tf.header.stamp.to_sec()
+        if stamp > 0.0:
+            self._late.age = max(self._late.age, rospy.get_time() - stamp)
         p = tf.transform.translation
         return np.array([p.x, p.y, p.z])
 
@@ -280,24 +301,27 @@ class ReplayServer:
         active_seen = False
         target = goal.press_force
         ours = True  # the move is still ours to stop (contact_control did not end it)
+        self._late = _Late()
         try:
             while not rospy.is_shutdown():
                 now = rospy.get_time()
+                if state == "replaying":
+                    self._late.gap = max(self._late.gap, now - last)
                 # A stall moves the program's clock on as far as the horizon that contact_control followed
                 # meanwhile, a clock jump no further; never backwards.
                 dt, last = min(max(now - last, 0.0), max(2.0 / s.replay_rate, s.replay_horizon)), now
                 if self._server.is_preempt_requested():
-                    return self._ended(False, f"cancelled at {play.progress:.0%}", distances, forces)
+                    return self._end(False, f"cancelled at {play.progress:.0%}", distances, forces)
                 status = self._status
                 if status is not None and status.move_active:
                     active_seen = True  # a status from before the laws were set would say "no move"
                 elif not active_seen and now - move_started > 2.0:
-                    return self._ended(False, "contact_control's status never showed the replay's move",
+                    return self._end(False, "contact_control's status never showed the replay's move",
                                        distances, forces)
                 if active_seen and status is not None and not status.move_active:
                     why = status.message or "contact_control ended the move"
                     ours = False  # its exceeded action (moving away) goes on
-                    return self._ended(False, f"stopped at {play.progress:.0%}: {why}", distances, forces)
+                    return self._end(False, f"stopped at {play.progress:.0%}: {why}", distances, forces)
                 force = 0.0
                 if status is not None:
                     f = status.wrench.force
@@ -311,7 +335,7 @@ class ReplayServer:
                         state, last = "replaying", rospy.get_time()
                         replay_started = last
                     elif now - move_started > s.press_timeout:
-                        return self._ended(False, f"no steady contact force along {goal.press_axis} within "
+                        return self._end(False, f"no steady contact force along {goal.press_axis} within "
                                                   f"{s.press_timeout:g} s", distances, forces)
                 else:
                     play.advance(dt, self._keep_up(play, tool, keep))
@@ -321,6 +345,8 @@ class ReplayServer:
                 distance = math.nan
                 if tool is not None and state == "replaying":
                     distance = float(path_distance(tool[None, keep], path[:, keep])[0])
+                    if distance > self._late.farthest:
+                        self._late.farthest, self._late.at = distance, play.progress
                     distances.append(distance)
                 self._send(play)
                 cycle += 1
@@ -338,10 +364,10 @@ class ReplayServer:
                                      f"({play.planned:.1f} s planned instead of {asked:.1f} s)")
                         if took > 1.1 * play.planned + 0.2:
                             done += f", and where the arm could not keep up ({took:.1f} s)"
-                        return self._ended(True, done,
+                        return self._end(True, done,
                                            distances, forces)
                 rate.sleep()
-            return self._ended(False, "shutting down", distances, forces)
+            return self._end(False, "shutting down", distances, forces)
         finally:
             if ours:
                 self._stop_move()
@@ -389,18 +415,19 @@ class ReplayServer:
         except (rospy.ServiceException, rospy.ROSException) as err:
             rospy.logwarn("teach: could not stop contact_control's move: %s", err)
 
-    @staticmethod
-    def _ended(ok: bool, message: str, distances: list[float], forces: list[float]) -> ReplayProgramResult:
+    def _end(self, ok: bool, message: str, distances: list[float],
+             forces: list[float]) -> ReplayProgramResult:
         result = ReplayProgramResult(success=ok, message=message)
         if distances:
             d = np.array(distances)
             result.path_error_rms, result.path_error_max = float(np.sqrt(np.mean(d**2))), float(np.max(d))
             result.message += f"; path error {result.path_error_rms * 1e3:.2f} mm RMS, " \
-                              f"{result.path_error_max * 1e3:.2f} mm max"
+                              f"{result.path_error_max * 1e3:.2f} mm max (at {self._late.at:.0%})"
         if forces:
             f = np.array(forces)
             result.force_mean, result.force_min, result.force_max = (float(f.mean()), float(f.min()),
                                                                      float(f.max()))
             result.message += (f"; force {result.force_mean:.2f} N ({result.force_min:.2f} to "
                                f"{result.force_max:.2f})")
+        result.message += self._late.said(1.0 / self.s.replay_rate)
         return result
