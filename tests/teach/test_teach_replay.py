@@ -46,8 +46,8 @@ def l_program(name: str, robot: str, joints: JointState, frames: tuple[str, str]
                    tip_frame=frames[1], waypoints=tuple(waypoints), samples=len(waypoints))
 
 
-def _start_of_the_l(rospy, robot: str, folder) -> None:
-    """The L saved as `l_path`, starting where the tool is."""
+def _where_the_tool_is(rospy, robot: str):
+    """The joint state, (base, tip) frames, the tool tip's position and orientation now: an L starts there."""
     buffer = tf2_ros.Buffer()
     listener = tf2_ros.TransformListener(buffer)  # noqa: F841 (fills the buffer)
     base, tip = TIP[robot]
@@ -56,7 +56,7 @@ def _start_of_the_l(rospy, robot: str, folder) -> None:
     start = (tf.translation.x, tf.translation.y, tf.translation.z)
     quat = (tf.rotation.x, tf.rotation.y, tf.rotation.z, tf.rotation.w)
     joints = rospy.wait_for_message("/joint_states", JointState, timeout=10)
-    ProgramStore(str(folder)).save(l_program("l_path", ROBOT[robot], joints, (base, tip), start, quat))
+    return joints, (base, tip), start, quat
 
 
 def test_a_stalled_replay_keeps_the_tool_on_the_l_and_its_result_says_it_ran_late(ros_node, tmp_path):
@@ -70,7 +70,9 @@ def test_a_stalled_replay_keeps_the_tool_on_the_l_and_its_result_says_it_ran_lat
         h.wait_for_service("/teach/pause", timeout=40)
         client = actionlib.SimpleActionClient("/teach/replay", ReplayProgramAction)
         assert client.wait_for_server(rospy.Duration(20.0))
-        _start_of_the_l(rospy, "ur5_custom", home / ".ros" / "compliant_programs")
+        joints, frames, start, quat = _where_the_tool_is(rospy, "ur5_custom")
+        ProgramStore(str(home / ".ros" / "compliant_programs")).save(
+            l_program("l_path", "ur5", joints, frames, start, quat))
         feedback = []
         client.send_goal(ReplayProgramGoal(name="l_path", speed=2.0), feedback_cb=feedback.append)
         wait_until(lambda: feedback and feedback[-1].progress > 0.6, 30, "the replay near the L's corner")
@@ -101,14 +103,7 @@ def test_replay_follows_the_l_presses_with_10_n_and_stops_pauses_cancels_and_ref
         h.wait_for_service("/teach/pause", timeout=40)
         client = actionlib.SimpleActionClient("/teach/replay", ReplayProgramAction)
         assert client.wait_for_server(rospy.Duration(20.0))
-        buffer = tf2_ros.Buffer()
-        listener = tf2_ros.TransformListener(buffer)  # noqa: F841 (fills the buffer)
-        base, tip = TIP[robot]
-        wait_until(lambda: buffer.can_transform(base, tip, rospy.Time(0)), 20, "the tool's tf")
-        tf = buffer.lookup_transform(base, tip, rospy.Time(0)).transform
-        start = (tf.translation.x, tf.translation.y, tf.translation.z)
-        quat = (tf.rotation.x, tf.rotation.y, tf.rotation.z, tf.rotation.w)
-        joints = rospy.wait_for_message("/joint_states", JointState, timeout=10)
+        joints, (base, tip), start, quat = _where_the_tool_is(rospy, robot)
         store = ProgramStore(str(folder))
         store.save(l_program("l_path", ROBOT[robot], joints, (base, tip), start, quat))
         # On the block (15 cm wide, the tool tip over its centre, a 3 cm tool radius): a smaller L toward the
