@@ -182,7 +182,7 @@ class _Cell:
         def ended() -> list[str]:
             return [e.message for e in self.events.msgs if e.type == ContactEvent.MOVE_ENDED]
 
-        wait_until(lambda: ended(), 5, "contact_control's move to end")
+        wait_until(ended, 5, "contact_control's move to end")
         why = ended()[0]
         assert "the robot stopped" in why or "over the global limit" in why, ended()
         print(f"\nthe move ended: {why}")

@@ -72,7 +72,7 @@ def test_a_stalled_replay_keeps_the_tool_on_the_l_and_its_result_says_it_ran_lat
         assert client.wait_for_server(rospy.Duration(20.0))
         joints, frames, start, quat = _where_the_tool_is(rospy, "ur5_custom")
         ProgramStore(str(home / ".ros" / "compliant_programs")).save(
-            l_program("l_path", "ur5", joints, frames, start, quat))
+            l_program("l_path", ROBOT["ur5_custom"], joints, frames, start, quat))
         feedback = []
         client.send_goal(ReplayProgramGoal(name="l_path", speed=2.0), feedback_cb=feedback.append)
         wait_until(lambda: feedback and feedback[-1].progress > 0.6, 30, "the replay near the L's corner")

@@ -311,17 +311,17 @@ class ReplayServer:
                 # meanwhile, a clock jump no further; never backwards.
                 dt, last = min(max(now - last, 0.0), max(2.0 / s.replay_rate, s.replay_horizon)), now
                 if self._server.is_preempt_requested():
-                    return self._end(False, f"cancelled at {play.progress:.0%}", distances, forces)
+                    return self._ended(False, f"cancelled at {play.progress:.0%}", distances, forces)
                 status = self._status
                 if status is not None and status.move_active:
                     active_seen = True  # a status from before the laws were set would say "no move"
                 elif not active_seen and now - move_started > 2.0:
-                    return self._end(False, "contact_control's status never showed the replay's move",
+                    return self._ended(False, "contact_control's status never showed the replay's move",
                                        distances, forces)
                 if active_seen and status is not None and not status.move_active:
                     why = status.message or "contact_control ended the move"
                     ours = False  # its exceeded action (moving away) goes on
-                    return self._end(False, f"stopped at {play.progress:.0%}: {why}", distances, forces)
+                    return self._ended(False, f"stopped at {play.progress:.0%}: {why}", distances, forces)
                 force = 0.0
                 if status is not None:
                     f = status.wrench.force
@@ -335,7 +335,7 @@ class ReplayServer:
                         state, last = "replaying", rospy.get_time()
                         replay_started = last
                     elif now - move_started > s.press_timeout:
-                        return self._end(False, f"no steady contact force along {goal.press_axis} within "
+                        return self._ended(False, f"no steady contact force along {goal.press_axis} within "
                                                   f"{s.press_timeout:g} s", distances, forces)
                 else:
                     play.advance(dt, self._keep_up(play, tool, keep))
@@ -364,10 +364,10 @@ class ReplayServer:
                                      f"({play.planned:.1f} s planned instead of {asked:.1f} s)")
                         if took > 1.1 * play.planned + 0.2:
                             done += f", and where the arm could not keep up ({took:.1f} s)"
-                        return self._end(True, done,
+                        return self._ended(True, done,
                                            distances, forces)
                 rate.sleep()
-            return self._end(False, "shutting down", distances, forces)
+            return self._ended(False, "shutting down", distances, forces)
         finally:
             if ours:
                 self._stop_move()
@@ -415,8 +415,8 @@ class ReplayServer:
         except (rospy.ServiceException, rospy.ROSException) as err:
             rospy.logwarn("teach: could not stop contact_control's move: %s", err)
 
-    def _end(self, ok: bool, message: str, distances: list[float],
-             forces: list[float]) -> ReplayProgramResult:
+    def _ended(self, ok: bool, message: str, distances: list[float],
+               forces: list[float]) -> ReplayProgramResult:
         result = ReplayProgramResult(success=ok, message=message)
         if distances:
             d = np.array(distances)
