@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from harness.demo_lines import free_replays, pressed_mean
 from thesis_demos.analysis import CONTACT_FORCE_BOUND, Recording, judge
 from thesis_demos.scenarios import SCENARIOS, by_name
 
@@ -186,6 +187,11 @@ def test_teach_and_replay_passes_with_the_path_kept_and_the_force_held():
     assert verdict.figures["taught X leg [mm]"] == pytest.approx(-80.0, abs=0.5)
     assert verdict.figures["free space 2x: path error max [mm]"] == pytest.approx(2.4)
     assert verdict.figures["pressing: mean contact force [N]"] == pytest.approx(10.0, abs=0.05)
+    # What the tests of `make demo` read back from the line (tests/harness/demo_lines.py).
+    figures = [verdict.figures[f"free space {k}: path error {m} [mm]"]
+               for k in ("1x", "2x") for m in ("RMS", "max")]
+    assert free_replays(verdict.summary) == pytest.approx(figures, abs=0.005)
+    assert pressed_mean(verdict.summary) == pytest.approx(10.0, abs=0.05)
 
 
 @pytest.mark.parametrize(

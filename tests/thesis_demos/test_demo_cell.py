@@ -7,6 +7,7 @@ import re
 import subprocess
 
 import pytest
+from harness.demo_lines import free_replays, pressed_mean
 from harness.launch import process_slot
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -19,8 +20,6 @@ pytestmark = [pytest.mark.e2e, pytest.mark.cell]  # scripts/demo_cell runs the s
 # its 10 +- 1.5 N band (50 ms means down to 8.24 N) while teach's loop ran 0.11 s late and the tool's pose on
 # tf was 0.13 s old: the band is judged where one arm runs (tests/teach, the demo command's tests); here the
 # press must hold 10 N on average, and the free replays stay on their path.
-_REPLAYED = re.compile(r"free space 1x (\S+) mm RMS, (\S+) mm max; free space 2x (\S+) mm RMS, (\S+) mm max; "
-                       r"pressing 10 N at \S+ held (\S+) N")
 _BAND_ONLY = re.compile(r" -- pressing 10 N at \S+: the force left 10 \+- 1\.5 N$")
 
 
@@ -37,9 +36,9 @@ def test_both_arms_of_the_cell_pass_their_demonstrations_at_the_same_time(tmp_pa
         verdicts = [x for x in run.stdout.splitlines() if x.startswith(f"[{arm}] [")]
         line = next((x for x in verdicts if "teach_and_replay" in x), "")
         assert f"[{arm}] [PASS] teach_and_replay" in line or _BAND_ONLY.search(line), said
-        numbers = _REPLAYED.search(line)
-        assert numbers, said
-        rms_1x, max_1x, rms_2x, max_2x, held = (float(x) for x in numbers.groups())
+        free, held = free_replays(line), pressed_mean(line)
+        assert free and held, said
+        rms_1x, max_1x, rms_2x, max_2x = free
         assert max(rms_1x, rms_2x) < 2.0 and max(max_1x, max_2x) < 5.0 and abs(held - 10.0) < 0.5, line
         assert (tmp_path / arm / "report.md").exists() and (tmp_path / arm / "spring_x.png").exists()
         assert "teach_and_replay: taught" in (tmp_path / arm / "demos.log").read_text()
