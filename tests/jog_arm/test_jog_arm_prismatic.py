@@ -7,6 +7,7 @@ import pathlib
 
 import numpy as np
 import pytest
+from jog_arm.settings import SettingsError
 from jog_arm_testing import PerfectArm, Robot, make_jog
 
 RAIL = Robot(
@@ -47,3 +48,38 @@ def test_the_rails_slow_down_zone_is_its_own(width: float) -> None:
     dq[0] = rail_speed
     assert lim.position_scale([0.41, *RAIL.start[1:]], dq.tolist()) == pytest.approx(
         0.03 / width, rel=0.01)
+
+
+# The rail 0.3 m off its middle, the arm folded (its tool 0.61 m from the carriage along x, so the arm can
+# reach over the rail's middle: at the stretched RAIL.start, 0.82 m out, it cannot, and the rail's share of
+# the self-motion is 0.009).
+FOLDED = (0.3, 0.0, -1.2, 1.6, -1.97, -1.571, 0.0)
+
+
+def test_a_free_rail_pulled_alone_goes_toward_its_middle_while_the_tool_goes_where_it_is_told() -> None:
+    """`nullspace_joints: [rail_joint]` with the rail's middle (0) in the posture: jogging the tool 0.1 m
+    along y and back, the self-motion takes the rail from 0.3 m to under 0.1 m, and the tool keeps its line;
+    pulling every joint toward the same posture (the default), the projected pull leaves the rail out (its
+    share of the self-motion is small)."""
+    ends = {}
+    for joints in ((), ("rail_joint",)):
+        jog = make_jog(RAIL, nullspace_gain=1.0, nullspace_joints=list(joints),
+                       nullspace_posture=[0.0, *FOLDED[1:]])
+        arm = PerfectArm(jog, FOLDED)
+        p0 = arm.eef()
+        off = []
+        for vy in (0.05, -0.05):
+            for _ in range(200):
+                arm.run(1, (0.0, vy, 0.0, 0.0, 0.0, 0.0))
+                d = arm.eef() - p0
+                off.append(float(np.hypot(d[0], d[2])))
+        assert max(off) < 3e-3, (joints, max(off))  # on the commanded line
+        assert abs(arm.eef()[1] - p0[1]) < 4e-3  # and back
+        ends[joints] = arm.q[0]
+    assert ends[("rail_joint",)] < 0.1, ends
+    assert ends[()] > 0.25, ends
+
+
+def test_a_pulled_joint_that_is_not_controlled_is_refused_by_name() -> None:
+    with pytest.raises(SettingsError, match="nullspace_joints: \\['elbow'\\]"):
+        make_jog(RAIL, nullspace_joints=["elbow"])

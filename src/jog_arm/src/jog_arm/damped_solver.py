@@ -32,6 +32,10 @@ _DAMPING_FLOOR = 1e-12
 # [rad] a joint step above this per period bends the tip's path enough to straighten (see `straighten`)
 _STRAIGHTEN_STEP = 1e-3
 _STRAIGHTEN_LIMIT = 0.1  # a correction above this fraction of the velocity is not applied
+# Damping μ² of the pulled joints' own task (S N Sᵀ + μ²I)⁻¹: where they take less than this share of the
+# self-motion they get a fraction of the pull, and the other joints never move more than 1 / (2 μ) = 2.2
+# times the pull's speed for them (a rail's share under an arm: 0.009-0.1, less the further it reaches).
+_PULL_DAMPING2 = 0.05
 
 
 class Geometry:
@@ -57,9 +61,12 @@ class DampedSolver:
         model: The arm model (its data is shared with the caller: see :meth:`invalidate`).
         settings: Validated parameters.
         posture: The null-space posture (model order), None: the configuration where motion starts.
+        pulled: 1 for each joint (model order) the pull moves toward the posture, 0 for one it leaves to the
+            self-motion; None: every joint.
     """
 
-    def __init__(self, model: ArmModel, settings: JogSettings, posture: FloatArray | None) -> None:
+    def __init__(self, model: ArmModel, settings: JogSettings, posture: FloatArray | None,
+                 pulled: FloatArray | None = None) -> None:
         self._model = model
         n = model.nv
         self._period = settings.pub_period
@@ -67,8 +74,14 @@ class DampedSolver:
         self._straighten_step = math.inf if settings.publish_on_command else _STRAIGHTEN_STEP
         self.retune(settings)
         self._posture_fixed = posture is not None
-        self._ns_gain = settings.nullspace_gain
-        # gain x posture, so the pull gain·(posture - q) costs two vector operations per cycle.
+        # Per joint gain (0 for a joint not pulled) and gain x posture: the pull gain·(posture - q) costs
+        # two vector operations per cycle.
+        # The pulled joints' indices and the identity of their task's size (None: every joint, projected).
+        self._pulled: tuple[np.ndarray, FloatArray] | None = None
+        if pulled is not None:
+            idx = np.flatnonzero(pulled)
+            self._pulled = (idx, np.eye(idx.size))
+        self._ns_gain = settings.nullspace_gain * (np.ones(n) if pulled is None else pulled)
         self._gain_posture = self._ns_gain * (np.zeros(n) if posture is None else posture)
         self._redundant = n > 6 and settings.nullspace_gain > 0.0
         self._inv_length = 1.0 / settings.singularity_length_scale
@@ -153,10 +166,28 @@ class DampedSolver:
             solved: FloatArray = llt.solve(x)  # eigenpy: untyped
             return J.T @ solved
         pull = (self._gain_posture - self._ns_gain * q_arr) * scale
+        if self._pulled is not None:
+            return self._pull_some(J, x, pull, *self._pulled)
         solved = llt.solve(x - J @ pull)
         dq_arr = J.T @ solved
         dq_arr += pull
         return dq_arr
+
+    def _pull_some(self, J: FloatArray, x: FloatArray, pull: FloatArray, idx: np.ndarray, eye: FloatArray
+                   ) -> FloatArray:
+        """dq = J⁺x + N Sᵀ(S N Sᵀ + μ²I)⁻¹(S·pull - S J⁺x): the pulled joints S (a rail) move at their pull
+        as far as the self-motion N = I - J⁺J lets them, the others as the self-motion needs (a secondary
+        task of its own, not the pull projected: a rail's small share of the self-motion would take it to
+        its middle at a tenth of the gain)."""
+        llt = self._llt
+        dq: FloatArray = J.T @ llt.solve(x)
+        # N Sᵀ = Sᵀ - J⁺J Sᵀ (n x k)
+        ns: FloatArray = -(J.T @ np.reshape(llt.solve(J[:, idx]), (J.shape[0], idx.size)))
+        ns[idx, np.arange(idx.size)] += 1.0
+        wanted: FloatArray = pull[idx] - dq[idx]
+        step: FloatArray = np.linalg.solve(ns[idx] + _PULL_DAMPING2 * eye, wanted)
+        dq += ns @ step
+        return dq
 
     def singularity_slowdown(self, g: Geometry, x: FloatArray) -> float:
         """Speed scale for the weighted root-axes twist `x` at `g`: below 1 only if the condition number

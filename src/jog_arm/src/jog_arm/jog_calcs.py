@@ -165,7 +165,14 @@ class JogCalcs:
                     f"for {n} joints"
                 )
             posture = self.joints.model_order(settings.nullspace_posture)
-        self.solver = DampedSolver(self.model, settings, posture)
+        pulled = None  # model order, 1 for a joint the null space pulls; None: every joint
+        if settings.nullspace_joints:
+            unknown = [j for j in settings.nullspace_joints if j not in self.model.joint_names]
+            if unknown:
+                raise SettingsError(f"jog_arm_server/nullspace_joints: {unknown} are not controlled joints "
+                                    f"{list(self.model.joint_names)}")
+            pulled = np.array([float(j in settings.nullspace_joints) for j in self.model.joint_names])
+        self.solver = DampedSolver(self.model, settings, posture, pulled)
         #: The collaborative speed cap (ISO/TS 15066).
         self.speed_cap = SpeedCap(self.model, settings.singularity_length_scale,
                                   settings.collaborative_region, settings.collaborative_payload)

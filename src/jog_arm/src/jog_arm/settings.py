@@ -187,6 +187,11 @@ class JogSettings:
         (), type="floats", unit="rad", shown_range="one per joint",
         doc="one value per joint; `[]` = posture when motion starts",
     )
+    nullspace_joints: tuple[str, ...] = param(
+        (), type="strings", shown_range="controlled joints",
+        doc="the joints the pull moves toward `nullspace_posture` as a task of their own, the others go "
+        "where the self-motion takes them (a rail kept near its middle: README, step 3); `[]` = every joint",
+    )
     integrate_from: str = param(
         "commanded", choices=INTEGRATE_FROM,
         doc="reference of the next point; `commanded` only with `command_out_type` trajectory (a robot "
