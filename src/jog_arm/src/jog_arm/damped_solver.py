@@ -74,13 +74,13 @@ class DampedSolver:
         self._straighten_step = math.inf if settings.publish_on_command else _STRAIGHTEN_STEP
         self.retune(settings)
         self._posture_fixed = posture is not None
-        # Per joint gain (0 for a joint not pulled) and gain x posture: the pull gain·(posture - q) costs
-        # two vector operations per cycle.
         # The pulled joints' indices and the identity of their task's size (None: every joint, projected).
         self._pulled: tuple[np.ndarray, FloatArray] | None = None
         if pulled is not None:
             idx = np.flatnonzero(pulled)
             self._pulled = (idx, np.eye(idx.size))
+        # Per joint gain (0 for a joint not pulled) and gain x posture: the pull gain·(posture - q) costs
+        # two vector operations per cycle.
         self._ns_gain = settings.nullspace_gain * (np.ones(n) if pulled is None else pulled)
         self._gain_posture = self._ns_gain * (np.zeros(n) if posture is None else posture)
         self._redundant = n > 6 and settings.nullspace_gain > 0.0
@@ -177,8 +177,7 @@ class DampedSolver:
                    ) -> FloatArray:
         """dq = J⁺x + N Sᵀ(S N Sᵀ + μ²I)⁻¹(S·pull - S J⁺x): the pulled joints S (a rail) move at their pull
         as far as the self-motion N = I - J⁺J lets them, the others as the self-motion needs (a secondary
-        task of its own, not the pull projected: a rail's small share of the self-motion would take it to
-        its middle at a tenth of the gain)."""
+        task of its own, not the pull projected: that moves a rail at its small share of the self-motion)."""
         llt = self._llt
         dq: FloatArray = J.T @ llt.solve(x)
         # N Sᵀ = Sᵀ - J⁺J Sᵀ (n x k)
