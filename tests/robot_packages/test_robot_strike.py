@@ -58,7 +58,7 @@ class Strike:
         self.began = rospy.Time(0)
         self._seen, self._touched = 0, False  # wrenches checked for the touch, and whether one was over
         self.stale = 0  # jog_arm's STALE_COMMAND statuses during the approach
-        self.last = (math.nan, math.nan, math.nan)  # the 0.1 s just before the touch: (ratio, cap, speed)
+        self.last = (math.nan, math.nan, math.nan)  # the 0.1 s nearest the touch: (ratio, cap, speed)
 
     def _force(self, m) -> float:
         f = m.wrench.force
@@ -105,7 +105,7 @@ class Strike:
                          if m.header.stamp.to_sec() < contact)
         # Each 0.1 s of the approach (stepped by 20 ms, up to 10 ms before the touch) against its cap: the
         # fastest, relative to what the cap allows, is the approach (a sender starved on a loaded machine
-        # lets jog_arm halt for a moment, which slows some windows; none may be faster than the cap).
+        # lets jog_arm halt for a moment, which slows some windows); the one nearest the touch is `last`.
         cap_t = np.array([m.header.stamp.to_sec() for m in statuses])
         cap_v = np.array([m.speed_cap for m in statuses])
         windows = []  # (speed / allowed, cap, speed), from the touch back
