@@ -35,6 +35,14 @@ def test_a_free_rail_is_a_joint_of_the_arm_with_its_servo_in_newtons_per_metre(t
     assert sim["servo"]["kp"]["rail_joint"] == pytest.approx(20000.0)  # 1000 N of effort, the rule's clamp
     assert "rail_joint (prismatic): the same numbers in N/m" in (package / "config" / "sim.yaml").read_text()
     assert check_package(str(package)) == []
+    # A null-space pull jog_arm would refuse is named (a hand edit: the rail's name misspelt)
+    jog_yaml = package / "config" / "jog_arm.yaml"
+    jog_yaml.write_text(jog_yaml.read_text() + "nullspace_joints: [rail]\nnullspace_posture: [0.0, 0.0]\n")
+    assert check_package(str(package)) == [
+        "jog_arm.yaml nullspace_joints: ['rail'] are not the arm's joints ['rail_joint', "
+        "'shoulder_pan_joint', 'shoulder_lift_joint', 'elbow_joint', 'wrist_1_joint', 'wrist_2_joint', "
+        "'wrist_3_joint']",
+        "jog_arm.yaml nullspace_posture: 2 values for the arm's 7 joints"]
 
 
 def test_a_held_rail_stays_where_held_and_the_arm_has_six_joints(tmp_path):
@@ -61,3 +69,4 @@ def test_only_a_linear_axis_of_the_arm_can_be_held():
     with pytest.raises(GeneratorError, match=r"HELD=elbow_joint: elbow_joint is an arm joint .* only a "
                                              r"linear axis \(a prismatic joint, a rail\) can be held"):
         plan_robot(spec, log=lambda _: None)
+

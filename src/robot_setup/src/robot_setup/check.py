@@ -141,6 +141,20 @@ def _description(args_path: str) -> tuple[str, argparse.Namespace]:
     return urdf, args
 
 
+def _nullspace_problems(jog: dict, joints: tuple[str, ...]) -> list[str]:
+    """jog_arm.yaml's null-space pull names the arm's joints, and its posture has one value per joint (jog_arm
+    would refuse to start otherwise)."""
+    problems = []
+    unknown = [j for j in jog.get("nullspace_joints") or [] if j not in joints]
+    if unknown:
+        problems.append(f"jog_arm.yaml nullspace_joints: {unknown} are not the arm's joints {list(joints)}")
+    posture = jog.get("nullspace_posture") or []
+    if posture and len(posture) != len(joints):
+        problems.append(f"jog_arm.yaml nullspace_posture: {len(posture)} values for the arm's {len(joints)} "
+                        "joints")
+    return problems
+
+
 def check_package(root: str) -> list[str]:
     """Every problem of the robot package at `root`, in plain words (empty: none).
 
@@ -202,6 +216,7 @@ def check_package(root: str) -> list[str]:
         arm = ArmModel(urdf, tip, tuple(jog.get("joint_names") or ()), held_positions=held)
     except KinematicsError as exc:
         return [*problems, f"jog_arm cannot model the arm: {exc}"]
+    problems += _nullspace_problems(jog, arm.joint_names)
     start = scene.get("start_pose") or {}
     missing = [j for j in arm.joint_names if j not in start]
     if missing:
