@@ -103,10 +103,9 @@ class TeachSettings:
     )
     replay_max_angle_error: float = param(0.2, unit="rad", gt=0.0, doc="same for rotations")
     replay_press_damping: float = param(
-        800.0, unit="N/(m/s)", gt=0.0,
-        doc="force tracking b on the press axis: the sixth demonstration's L on the simulated block held "
-        "9.16-10.76 N (UR5) and 8.79-10.92 N (UR3) at 800, 9.43-11.44 and 8.93-11.26 at 2000 (friction "
-        "turning at the corner); 500 rings (contact_control's README, Force tracking)",
+        600.0, unit="N/(m/s)", gt=0.0,
+        doc="force tracking b on the press axis: a larger b corrects later where friction turns (the L's "
+        "corner; README, *Compliant replay*); 500 rings (contact_control's README, Force tracking)",
     )
     replay_press_approach: float = param(
         0.005, unit="m/s", gt=0.0,
