@@ -1,7 +1,7 @@
-"""Clamp release (ISO/TS 15066): a contact force held over the body region's quasi-static limit, or over the
-contact guard's while a push into it is stopped, is a clamp; the arm backs off along the force until it is
-below 10 N, whatever it is told meanwhile. A short peak is not a clamp. The rules on their own, then in the
-compliant pipeline with a perfect arm pressing a hand of 75 N/mm (ISO/TS 15066's)."""
+"""Clamp release (ISO/TS 15066): a contact force held over the body region's quasi-static limit, or over
+clamp_push_force while the contact guard holds a push into it back, is a clamp; the arm backs off along the
+force until it is below 10 N, whatever it is told meanwhile. A short peak is not a clamp. The rules on their
+own, then in the compliant pipeline with a perfect arm pressing a hand of 75 N/mm (ISO/TS 15066's)."""
 
 from __future__ import annotations
 
@@ -31,13 +31,14 @@ def test_a_sustained_force_over_the_limit_is_released_and_a_spike_is_not():
     assert clamp.check((0.0, 0.0, 150.0), 0.0, 0.25, 0.41) is None  # a new clamp needs a new hold
 
 
-def test_while_a_push_is_stopped_the_guard_limit_counts_and_no_force_releases_nothing():
-    clamp = ClampRelease(140.0, 20.0, 0.05, 0.02, 10.0)  # released below 10 N here (the default: 5 N)
+def test_while_a_push_is_held_back_the_push_force_counts_and_no_force_releases_nothing():
+    clamp = ClampRelease(140.0, 15.0, 0.05, 0.02, 10.0)  # released below 10 N here (the default: 3 N)
     for t in (0.0, 0.03):
         assert clamp.check((0.0, 0.0, 60.0), 0.0, 0.25, t) is None  # 60 N: under the hand's limit
-    assert clamp.check((0.0, 0.0, 60.0), 0.0, 0.25, 0.04, pushed=True) is None
-    assert clamp.check((0.0, 0.0, 60.0), 0.0, 0.25, 0.10, pushed=True) is not None
-    assert clamp.by_push and "contact guard's 20 N" in clamp.limit_words("hand")
+    assert clamp.check((0.0, 0.0, 14.9), 0.0, 0.25, 0.04, pushed=True) is None  # under the push force
+    assert clamp.check((0.0, 0.0, 15.0), 0.0, 0.25, 0.05, pushed=True) is None  # the hold starts
+    assert clamp.check((0.0, 0.0, 15.0), 0.0, 0.25, 0.11, pushed=True) is not None
+    assert clamp.by_push and "15 N while a push into it was held back" in clamp.limit_words("hand")
     other = ClampRelease(140.0, 20.0, 0.05, 0.02, 10.0)
     assert other.check((0.0, 0.0, 300.0), 0.5, 0.25, 0.0) is None  # stale: which way is away is unknown
     assert other.check((math.nan, 0.0, 300.0), 0.0, 0.25, 0.1) is None
@@ -120,8 +121,28 @@ def test_a_push_into_the_hand_that_overshoots_the_guard_is_released_though_the_p
     hand.run(0.2, twist=(0.0, 0.0, 0.02, 0.0, 0.0, 0.0))  # another key at once, away from the hand: moves
     assert hand.tip_z() > z + 0.002
     hand.run(0.2)  # let go
-    hand.run(1.2, twist=(0.0, 0.0, -0.01, 0.0, 0.0, 0.0))  # pressed again, slowly: the guard's press
-    assert 2.0 < hand.forces[-1] < 20.0
+    pressed = len(hand.forces)
+    hand.run(1.5, twist=(0.0, 0.0, -0.01, 0.0, 0.0, 0.0))  # pressed again, slowly, the key held
+    again = np.array(hand.forces[pressed:])
+    # The guard slows the push from its 2 N on; held back over clamp_push_force (10 N), it is a clamp too.
+    assert 10.0 <= again.max() < 20.0 and again[-1] < 3.0
+    assert StatusCode.CLAMP_RELEASE in [code for code, _ in hand.statuses[pressed:]]
+
+
+def test_a_slow_push_is_released_where_the_guard_would_have_held_it_and_off_it_holds():
+    """A held 1 cm/s jog onto the hand: the guard's slow zone lands it at its 20 N and holds it there while
+    the key is held. With the collaborative setting on the push held back over clamp_push_force is a clamp,
+    released below 3 N; with the region `off` the guard holds it under 20 N."""
+    ends = {}
+    for region in ("hand", "off"):
+        hand = HandCell("ur5", pressed=-0.002, jog={"collaborative_region": region})
+        hand.run(2.0, twist=(0.0, 0.0, -0.01, 0.0, 0.0, 0.0))
+        forces = np.array(hand.forces)
+        ends[region] = (float(forces.max()), float(forces[-250:].mean()))
+        print(f"\nUR5 jog at 0.01 m/s into the hand, region {region}: peak {ends[region][0]:.1f} N, "
+              f"the last 0.5 s {ends[region][1]:.1f} N")
+    assert ends["hand"][0] < 20.0 and ends["hand"][1] < 3.0
+    assert 15.0 < ends["off"][1] <= 20.0
 
 
 def test_a_push_stopped_at_the_contact_brakes_at_the_contact_stop_scale():

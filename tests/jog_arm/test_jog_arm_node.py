@@ -336,7 +336,8 @@ def test_contact_controls_twists_pass_the_guard_and_others_do_not(ros_node) -> N
     (contact_cmd_in_topic). At 25 N (over the 20 N guard limit) a twist into the contact on cmd_in_topic (a
     keyboard's) becomes a retreat, the same twist on contact_cmd_in_topic passes: contact_control's laws react
     to the force themselves (a compliant move's move_away, a force-tracking press). Both come from this one
-    node: nothing depends on who sends."""
+    node: nothing depends on who sends. (The collaborative region is off: with it, the held push would be a
+    clamp, backed off at clamp_release_speed: test_jog_arm_clamp.)"""
     from geometry_msgs.msg import WrenchStamped
     from std_msgs.msg import Float64MultiArray
 
@@ -344,7 +345,7 @@ def test_contact_controls_twists_pass_the_guard_and_others_do_not(ros_node) -> N
     params = {
         "command_out_type": "velocity_array", "integrate_from": "measured",
         "contact_guard_wrench_topic": "/jog_guard/contact",
-        "contact_cmd_in_topic": "/jog_guard/contact_twist",
+        "contact_cmd_in_topic": "/jog_guard/contact_twist", "collaborative_region": "off",
     }
     contact = rospy.Publisher("/jog_guard/contact", WrenchStamped, queue_size=1)
     press = WrenchStamped()

@@ -66,6 +66,7 @@ def test_fork_yaml_layout_is_read() -> None:
         ({"held_joints": [{"head_1_joint": "up"}]}, "held_joints/head_1_joint"),
         ({"held_joints": ["head_1_joint"]}, "held_joints"),
         ({"command_out_type": "velocity_array"}, "integrate_from"),  # commanded: trajectory output only
+        ({"clamp_push_force": 2.0}, "clamp_release_force must be below clamp_push_force"),  # 3 N: re-clamps
     ],
     ids=lambda v: v if isinstance(v, str) else None,
 )

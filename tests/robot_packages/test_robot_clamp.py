@@ -1,9 +1,7 @@
 """End to end, ISO/TS 15066's hand (mujoco_driver fixture:=hand: 0.6 kg, 75 N/mm) lying on the block: a jog
-down onto it from an outside source (the keyboard's path), held, overshoots the contact guard and pins the
-hand, below the hand's quasi-static 140 N (the contact stop brakes hard); jog_arm releases the clamp below
-10 N within a second of the peak, says so, and the held key moves nothing more until it is let go of. On a
-loaded machine the guard may instead land the touch at its own force (nothing pinned past it): then the
-hand stays at the guard's force after the touch's impact.
+down onto it from an outside source (the keyboard's path), held, pins the hand, below the hand's
+quasi-static 140 N (the contact stop brakes hard); jog_arm releases the clamp below 10 N within a second of
+the peak, says so, and the held key moves nothing more until it is let go of.
 
 The robots: harness.hand_scene."""
 
@@ -23,9 +21,6 @@ pytestmark = pytest.mark.cobot_safety
 
 SPEED = 0.1  # [m/s] a keyboard's jog down onto the hand
 HAND_LIMIT = 140.0  # [N] ISO/TS 15066 Annex A, hand, quasi-static
-GUARD = 20.0  # [N] jog_arm's contact_guard_max_force
-HOLD = 0.05  # [s] jog_arm's clamp_hold
-PARKED = 2.0  # [s] the guard holding the touch this long without a clamp: it landed it
 
 
 @pytest.mark.parametrize("robot, single_process", LAYOUTS)
@@ -35,11 +30,9 @@ def test_a_hand_pinned_by_a_jog_is_released_below_10_newtons_within_a_second(ros
         h.wait_for_service("/contact_control_node/tare", timeout=40)
         wrench = Collector("/wrench", WrenchStamped, queue_size=20000)
         status = Collector("/jog_arm_server/status", JogStatus, queue_size=20000)
-        # the force the clamp reads
-        seen = Collector("/contact_control_node/contact_wrench", WrenchStamped, queue_size=20000)
         pub = rospy.Publisher("/jog_arm_server/delta_jog_cmds", TwistStamped, queue_size=1, tcp_nodelay=True)
         try:
-            for c in (wrench, status, seen):
+            for c in (wrench, status):
                 c.wait_for(1, timeout=20)
             wait_until(lambda: pub.get_num_connections() > 0, 10, "jog_arm to subscribe to its input")
             f = wrench.last().wrench.force
@@ -48,19 +41,14 @@ def test_a_hand_pinned_by_a_jog_is_released_below_10_newtons_within_a_second(ros
             twist.header.frame_id = BASE_FRAME[robot]
             twist.twist.linear.z = -SPEED
             rate = rospy.Rate(100)  # the sender's rate, like key_to_twist's repeat
-            released_at = parked_since = None
+            released_at = None
             start = rospy.get_time()
             while released_at is None or rospy.get_time() - released_at < 1.0:  # the key held 1 s more
                 assert h.proc.poll() is None, h.output()[-3000:]
-                assert rospy.get_time() - start < 30.0, "no clamp release seen"
                 said = status.last()
+                assert rospy.get_time() - start < 30.0, f"no clamp release: {said.code_name} {said.message}"
                 if released_at is None and "clamp released" in said.message:
                     released_at = rospy.get_time()
-                landing = released_at is None and said.code == JogStatus.CONTACT_GUARD and \
-                    "stopped until below" in said.message
-                parked_since = (parked_since or rospy.get_time()) if landing else None
-                if parked_since is not None and rospy.get_time() - parked_since > PARKED:
-                    break  # the guard stopped the touch at its force: nothing past it to release
                 twist.header.stamp = rospy.Time.now()
                 pub.publish(twist)
                 rate.sleep()  # the sender's rate, not a wait for a result
@@ -71,51 +59,23 @@ def test_a_hand_pinned_by_a_jog_is_released_below_10_newtons_within_a_second(ros
             raw = np.linalg.norm(np.array([[v.x, v.y, v.z] for _, v in sensed]) - weight, axis=1)
             force = np.convolve(raw, np.ones(5) / 5, mode="same")  # 10 ms means: the force, not the noise
             peak = int(np.argmax(force))
-            if released_at is None:
-                # On a loaded machine the guard's slow zone can land the touch at its limit (seen in CI:
-                # parked at 18.9-19.4 N). The touch's impact still peaks in this raw reading (53 N in CI,
-                # 55-71 N where the clamp fired), but the stack's force is low-passed (contact_control, 5 Hz)
-                # and never stayed over the guard's limit for clamp_hold: nothing pinned the hand past it.
-                held = force[t >= ended.to_sec() - PARKED]
-                print(f"\n{robot}: jog at {SPEED} m/s into the hand: the guard landed it (peak "
-                      f"{force[peak]:.1f} N) and held {held.mean():.1f} N")
-                # (This raw reading minus the start's weight sits up to a few N above the guard's compensated
-                # one, as for test_robot_contact_guard's touches.)
-                assert force[peak] <= HAND_LIMIT, "the contact stop did not brake before the hand's limit"
-                assert held.mean() <= GUARD + 3.0, f"the hand was held at {held.mean():.1f} N, past the guard"
-                over = _longest_over([(m.header.stamp.to_sec(), m.wrench.force) for m in list(seen.msgs)],
-                                     GUARD)
-                assert over < HOLD + 0.02, \
-                    f"the stack's force was over {GUARD:g} N for {over:.3f} s and no clamp released"
-            else:
-                below = peak + int(np.argmax(force[peak:] < 10.0))
-                saying = [m.message for m in status.msgs if m.code == JogStatus.CLAMP_RELEASE]
-                print(f"\n{robot}: jog at {SPEED} m/s into the hand: peak {force[peak]:.0f} N, below 10 N "
-                      f"{t[below] - t[peak]:.3f} s later, then at most "
-                      f"{force[t >= t[below] + 0.05].max():.1f} N while the key was held; {saying[:1]}")
-                assert force[peak] > 20.0, "the jog did not pin the hand past the guard"
-                assert force[peak] <= HAND_LIMIT  # the contact stop brakes before the hand's quasi-static one
-                assert force[below] < 10.0 and t[below] - t[peak] < 1.0
-                # The held key moved nothing more: from 50 ms after the crossing on (the release goes on to
-                # clamp_release_force by the stack's compensated force; this raw reading minus the start's
-                # weight sat up to 5 N above it).
-                after = force[t >= t[below] + 0.05]
-                assert after.size and after.max() < 10.0
-                assert saying and "backing off along the force" in saying[0]
+            below = peak + int(np.argmax(force[peak:] < 10.0))
+            saying = [m.message for m in status.msgs if m.code == JogStatus.CLAMP_RELEASE]
+            print(f"\n{robot}: jog at {SPEED} m/s into the hand: peak {force[peak]:.0f} N, below 10 N "
+                  f"{t[below] - t[peak]:.3f} s later, then at most "
+                  f"{force[t >= t[below] + 0.05].max():.1f} N while the key was held; {saying[:1]}")
+            assert force[peak] > 10.0, "the jog did not press the hand"
+            assert force[peak] <= HAND_LIMIT  # the contact stop brakes before the hand's quasi-static one
+            assert force[below] < 10.0 and t[below] - t[peak] < 1.0
+            # The held key moved nothing more: from 50 ms after the crossing on (the release goes on to
+            # clamp_release_force by the stack's compensated force; this raw reading minus the start's
+            # weight sat up to 5 N above it).
+            after = force[t >= t[below] + 0.05]
+            assert after.size and after.max() < 10.0
+            assert saying and "backing off along the force" in saying[0]
         finally:
-            for c in (wrench, status, seen):
+            for c in (wrench, status):
                 c.close()
             pub.unregister()
         h.stop()
 
-
-def _longest_over(sensed: list, limit: float) -> float:
-    """The longest time [s] the force's magnitude stayed at or over `limit` [N]."""
-    longest, since = 0.0, None
-    for t, f in sensed:
-        if np.linalg.norm([f.x, f.y, f.z]) >= limit:
-            since = t if since is None else since
-            longest = max(longest, t - since)
-        else:
-            since = None
-    return longest

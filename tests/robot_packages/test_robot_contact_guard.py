@@ -1,6 +1,7 @@
 """End to end: jogging into the obstacle block from an outside source (a TwistStamped stream into
-/jog_arm_server/delta_jog_cmds, the keyboard's path) is stopped by jog_arm's contact-force guard before the
-contact force reaches its limit; ~status says why; a twist away from the contact moves the arm out.
+/jog_arm_server/delta_jog_cmds, the keyboard's path) is slowed and stopped by jog_arm's contact-force guard,
+and the press it held back is released below 3 N as a clamp (the collaborative setting); ~status says why;
+a twist away from the contact moves the arm out.
 
 The UR5 runs the default single process (control_stack: the guard reads contact_control's force in-process),
 the Panda the two-node layout (jog_arm reads contact_control's ~contact_wrench topic)."""
@@ -24,7 +25,7 @@ BASE_FRAME = {"ur5_custom": "base_link", "panda_custom": "panda_link0"}
 JOG_SPEED = 0.01  # [m/s] down onto the block, 7 cm below the start pose
 GUARD_FORCE = 20.0  # [N] contact_guard_max_force in jog_arm's YAML
 # Faster, the force overshoots the guard by about speed x 50 ms (jog_arm and the servos) x 20 N/mm (the stiff
-# arm on the block) before the guard's stop takes effect; the guard then backs off while the key is held.
+# arm on the block) before the guard's stop takes effect (peaks of 52-127 N measured).
 
 
 FAST = 0.05  # [m/s] a keyboard-like speed: the guard cannot stop the touch in time, but stops the press
@@ -76,9 +77,11 @@ def test_jogging_into_the_block_stops_under_the_guard_force_and_backing_out_work
 
             z0 = z()
             wrench.clear()
-            # Down onto the block until the guard speaks.
-            jog(-speed, lambda: status.last().code == JogStatus.CONTACT_GUARD, 0.0, "the guard to act")
-            # Keep the key down: after a fast touch the guard backs off; then 1 s more of pushing.
+            # Down onto the block until the guard speaks (a hard touch may go straight to the clamp).
+            acting = (JogStatus.CONTACT_GUARD, JogStatus.CLAMP_RELEASE)
+            jog(-speed, lambda: status.last().code in acting or "clamp released" in status.last().message,
+                0.0, "the guard to act")
+            # Keep the key down while the clamp backs off; then 1 s more of pushing.
             jog(-speed, lambda: "backing off" not in status.last().message, 1.0, "the backing off to end")
             stopped = rospy.Time.now()
             # The collectors may trail the stack on 2 cores: read once they caught up with the key's release.
@@ -94,27 +97,21 @@ def test_jogging_into_the_block_stops_under_the_guard_force_and_backing_out_work
                   f"held {held:.2f} N (guard {GUARD_FORCE:g} N); went down {(z0 - z()) * 1e3:.1f} mm; "
                   f"status {said.code_name}: {said.message}")
             assert z0 - z() > 0.05, "it did not reach the block"
+            # The guard slows the push from 2 N on; with the collaborative setting on (every robot package's
+            # default) a press it holds back over clamp_push_force (10 N) for clamp_hold is a clamp, backed
+            # off below 3 N, and the held key presses no more until its stream pauses (jog_arm README,
+            # Clamping). After a hard touch the guard's own retreat may already have taken the force under
+            # 10 N. This raw reading sits up to a few N above the stack's compensated one; a pause in this
+            # sender's stream on a loaded machine would press again before the next release. Without the
+            # clamp rule the press held 19.6-21.6 N.
+            assert held <= 12.0, held
+            guarded = said.code == JogStatus.CONTACT_GUARD and "moving away is allowed" in said.message
             if speed <= JOG_SPEED:
-                assert said.code == JogStatus.CONTACT_GUARD and said.code_name == "CONTACT_GUARD"
-                assert "contact guard" in said.message, said.message
-                assert "moving away is allowed" in said.message, said.message
-                # The guard's slow zone lets the force approach its limit and no further (the driver's raw
-                # reading and contact_control's compensated one, which the guard sees, agree within 0.1 N).
-                # With two nodes the force comes over a topic from another process: a stall of either lets
-                # the slow approach go on a little longer (21.6 N seen once in CI, 20.0 N in every other run;
-                # the guard then backs off to 90 %). Still under contact_control's 25 N global limit.
-                overshoot = 0.5 if single_process else 2.0
-                assert peak <= GUARD_FORCE + overshoot, peak
-                assert held <= GUARD_FORCE + 0.5, held
+                # Slow enough for the guard's slow zone, which would land it at 20 N: released instead.
+                assert "clamp released" in said.message, said.message
+                assert peak <= GUARD_FORCE + (0.5 if single_process else 2.0), peak
             else:
-                # A hard touch (peaks of 52-127 N measured): the guard backs off while the key is held, or,
-                # when the touch stayed over the guard's force for clamp_hold, jog_arm released it as a clamp
-                # (jog_arm README, Clamping) and the held key presses no more. Either way the press ends at
-                # about the guard force or below: 19.6-21.6 N by the driver, whose reading differs from the
-                # guard's with the tool strained sideways by friction. Under contact_control's 25 N.
-                guarded = said.code == JogStatus.CONTACT_GUARD and "moving away is allowed" in said.message
                 assert guarded or "clamp released" in said.message, said.message
-                assert held <= GUARD_FORCE + 3.0, held
             # Away from the contact: up 2 cm.
             pressed = z()
             jog(JOG_SPEED, lambda: z() - pressed > 0.02, 0.0, "the arm to back out")

@@ -1,9 +1,9 @@
 """Clamp release (ISO/TS 15066; the package README, *Clamping*): a contact force at or over the body region's
 quasi-static limit for `hold` seconds is a clamp (a person pinned between the tool and something), and so
-is one at or over `push_limit` (the contact guard's) for `hold` while a push into it is being stopped (the
-arm overshot the guard: it pins what it touched). The arm then backs off along the measured force at
-`speed` until the force is below `release`, whatever it was commanded, and stops. A shorter peak (a strike,
-a spike) is not a clamp. No ROS here.
+is one at or over `push_limit` for `hold` while the contact guard holds a push into it back: the arm pins
+what it touched, whether it overshot the guard or the guard's slow zone landed it at its limit. The arm
+then backs off along the measured force at `speed` until the force is below `release`, whatever it was
+commanded, and stops. A shorter peak (a strike, a spike) is not a clamp. No ROS here.
 
 Without a fresh, finite force the direction away is unknown: nothing is released, and the command stands
 (the contact guard stops outside twists on such a force).
@@ -22,7 +22,7 @@ class ClampRelease:
 
     Args:
         limit: |F| [N] at or over which a sustained contact is a clamp (the region's quasi-static force).
-        push_limit: the same while a push into the contact is being stopped (the contact guard's limit).
+        push_limit: the same while a push into the contact is being held back (slowed or stopped).
         hold: how long [s] |F| must stay at or over `limit`.
         speed: retreat speed [m/s] along the force.
         release: the retreat ends below this |F| [N].
@@ -39,7 +39,7 @@ class ClampRelease:
     def limit_words(self, region: str) -> str:
         """Which limit the clamp being released crossed, in words."""
         if self.by_push:
-            return f"the contact guard's {self.push_limit:g} N while a push into it was stopped"
+            return f"{self.push_limit:g} N while a push into it was held back"
         return f"the {region}'s {self.limit:g} N (ISO/TS 15066)"
 
     def check(self, force: Sequence[float] | None, age: float, timeout: float, t: float, pushed: bool = False
@@ -50,7 +50,7 @@ class ClampRelease:
             force: the contact force on the tool (fx, fy, fz) [N]; None: none received.
             age: how old it is [s]; older than `timeout` counts as none.
             t: now [s].
-            pushed: a push into the contact is being stopped now.
+            pushed: a push into the contact is being held back now.
         """
         if force is None or age > timeout:
             self._over_since = None

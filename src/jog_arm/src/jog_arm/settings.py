@@ -245,6 +245,10 @@ class JogSettings:
         0.05, "s", "a contact force at or over the region's quasi-static limit this long is a clamp (README: "
         "[clamping](#clamping)); shorter peaks (a strike) are not",
     )
+    clamp_push_force: float = _pos(
+        10.0, "N", "a contact force at or over this for clamp_hold while the contact guard holds a push into "
+        "it back (slows or stops it) is a clamp (README: [clamping](#clamping))",
+    )
     clamp_release_speed: float = _pos(0.02, "m/s", "a clamp is released backing off along the force at this")
     contact_stop_scale: float = param(
         5.0, ge=1.0,
@@ -328,6 +332,11 @@ class JogSettings:
                 f"{prefix}contact_guard_slow_force must be below contact_guard_max_force "
                 f"({self.contact_guard_max_force} N), got {self.contact_guard_slow_force}"
             )
+        if not self.clamp_release_force < self.clamp_push_force:
+            raise SettingsError(
+                f"{prefix}clamp_release_force must be below clamp_push_force ({self.clamp_push_force} N), "
+                f"got {self.clamp_release_force}: a released clamp would be one again at once"
+            )
         if self.integrate_from == "commanded" and self.command_out_type == "velocity_array":
             # The robot holds a velocity over a late cycle; the commanded reference advances one pub_period
             # per cycle: it falls behind the arm (README, integrate_from).
@@ -378,7 +387,7 @@ TUNABLE = (
     "singularity_threshold", "hard_stop_singularity_threshold", "pinv_damping", "pinv_damping_threshold",
     "contact_guard_max_force", "contact_guard_slow_force", "contact_guard_slow_speed",
     "contact_guard_timeout", "contact_guard_relief_speed", "collaborative_region", "collaborative_payload",
-    "clamp_hold", "clamp_release_speed", "clamp_release_force",
+    "clamp_hold", "clamp_push_force", "clamp_release_speed", "clamp_release_force",
 )
 
 

@@ -131,7 +131,7 @@ class JogStage:
         self._guard_acted = False
         self.clamp = ClampRelease(math.inf, math.inf, s.clamp_hold, s.clamp_release_speed,
                                   s.clamp_release_force)
-        self._push_stopped = -math.inf  # when the contact guard last stopped a push at its limit
+        self._push_held = -math.inf  # when the contact guard last held a push into the contact back
         self._last_guarded = -math.inf  # when the last guarded (outside) twist arrived
         self._await_pause = False  # after a clamp: pushes into it are ignored until their stream pauses
         self._away = (0.0, 0.0, 0.0)  # the last clamp's retreat direction (planning_frame)
@@ -153,7 +153,7 @@ class JogStage:
         c = self.clamp
         c.limit = math.inf if s.collaborative_region == OFF else region_named(s.collaborative_region).force
         c.hold, c.speed, c.release = s.clamp_hold, s.clamp_release_speed, s.clamp_release_force
-        c.push_limit = s.contact_guard_max_force if s.contact_guard_enabled else math.inf
+        c.push_limit = s.clamp_push_force if s.contact_guard_enabled else math.inf
 
     # --- inputs ---
     def on_joint_state(self, names: Sequence[str], positions: Sequence[float], t: float) -> bool:
@@ -238,10 +238,10 @@ class JogStage:
                 else:
                     force = _rotate(pose, raw)
         result = self.guard.limit(twist, force, age)
-        if result.blocked and result.force >= self.guard.max_force and force is not None and \
-                _pushes_into(twist, force):
-            self._push_stopped = t
-            self.jog.braking = True  # a push stopped at the contact: brake as hard as allowed
+        if result.acted and force is not None and _pushes_into(twist, force):
+            self._push_held = t
+            if result.blocked and result.force >= self.guard.max_force:
+                self.jog.braking = True  # a push stopped at the contact: brake as hard as allowed
         if result.message != self._guard_note and result.acted:
             self.notes.append(("warn_throttle", result.message))
         self._guard_note, self._guard_acted = result.message, result.acted
@@ -255,7 +255,7 @@ class JogStage:
         retreat = None
         if contact is not None and clamp.limit < math.inf:
             raw, frame, measured = contact
-            pushed = t - self._push_stopped <= max(clamp.hold, PUSH_GAP)  # twists come at 10 Hz or more
+            pushed = t - self._push_held <= max(clamp.hold, PUSH_GAP)  # twists come at 10 Hz or more
             retreat = clamp.check(raw, t - measured, self.settings.contact_guard_timeout, t, pushed)
         if retreat is None:
             if was:
