@@ -29,6 +29,7 @@ from thesis_demos.bimanual import (
     lift_laws,
     reach_laws,
 )
+from thesis_demos.path_silence import silence_words
 from thesis_demos.stack_client import StackClient
 
 __all__ = ["BimanualFlow"]
@@ -45,11 +46,14 @@ class BimanualFlow:
         self._holder, self._presser, self._tasks, self._world = holder, presser, tasks, world_frame
         self._lock = threading.Lock()
         self._following: list[float] = []  # stamps of the feedback while the path server's step is `follow`
+        self._last: tuple[float, str, float, float] | None = None  # the last feedback (path_silence)
 
     def _on_feedback(self, fb: FollowPathAtForceFeedback) -> None:
-        if fb.step == "follow":
-            with self._lock:
-                self._following.append(rospy.get_time())
+        now = rospy.get_time()
+        with self._lock:
+            self._last = (now, fb.step, fb.progress, fb.force)
+            if fb.step == "follow":
+                self._following.append(now)
 
     def run(self, spec: Bimanual, sensor_frame: str, timeout: float = 60.0) -> BimanualRecording:
         """The whole demonstration from both arms' start poses; both back there afterwards.
@@ -112,7 +116,10 @@ class BimanualFlow:
         limit = float(np.hypot(*spec.slide)) / BIMANUAL_SPEED + timeout
         if not client.wait_for_result(rospy.Duration(limit)):
             client.cancel_goal()
-            raise TimeoutError(f"~follow_path gave no answer within {limit:g} s")
+            with self._lock:
+                last = self._last
+            raise TimeoutError(f"~follow_path gave no answer within {limit:g} s; "
+                               f"{silence_words(last, rospy.get_time())}")
         result = client.get_result()
         presser.stop()
         lifting = presser.send_laws(lift_laws())

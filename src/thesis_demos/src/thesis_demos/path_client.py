@@ -19,6 +19,7 @@ from contact_control.frames import quaternion_matrix
 from geometry_msgs.msg import Pose, PoseStamped
 
 from thesis_demos.finishing import PathRecording
+from thesis_demos.path_silence import silence_words
 from thesis_demos.scenarios import PathDemo
 from thesis_demos.stack_client import StackClient
 from thesis_demos.surfaces import cylinder_path
@@ -96,7 +97,10 @@ class PathFlow:
             limit = demo.length / demo.speed + ANSWER_MARGIN
             if not client.wait_for_result(rospy.Duration(limit)):
                 client.cancel_goal()
-                raise TimeoutError(f"~follow_path gave no answer within {limit:g} s")
+                with self._lock:
+                    last = self._feedback[-1][:4] if self._feedback else None
+                raise TimeoutError(f"~follow_path gave no answer within {limit:g} s; "
+                                   f"{silence_words(last, rospy.get_time())}")
             result = client.get_result()
         finally:
             sub.unregister()
