@@ -157,3 +157,35 @@ def test_a_push_stopped_at_the_contact_brakes_at_the_contact_stop_scale():
           f"{peaks[5.0]:.0f} N at 5 x")
     assert peaks[5.0] < 0.6 * peaks[1.0]
     assert peaks[5.0] < 140.0  # under the hand's quasi-static limit
+
+
+def test_a_retreat_the_force_does_not_follow_stops_after_its_travel():
+    clamp = ClampRelease(140.0, 10.0, 0.05, 0.02, 3.0, travel=0.05)
+    for t in (0.0, 0.06):
+        clamp.check((0.0, 0.0, 60.0), 0.0, 0.25, t, pushed=True)
+    assert clamp.active
+    assert clamp.check((0.0, 0.0, 60.0), 0.0, 0.25, 2.5) is not None  # 2.44 s at 0.02 m/s: 48.8 mm
+    assert clamp.check((0.0, 0.0, 60.0), 0.0, 0.25, 2.6) is None and clamp.stuck and not clamp.active
+    assert clamp.check((0.0, 0.0, 200.0), 0.0, 0.25, 3.0, pushed=True) is None  # no new clamp while stuck
+    assert clamp.check((0.0, 0.0, 1.0), 0.0, 0.25, 3.1) is None and not clamp.stuck  # the force let go
+
+
+class StuckSensorCell(HandCell):
+    """The same pipeline whose sensor reads 60 N up whatever the tool does."""
+
+    def force(self) -> float:
+        return 60.0
+
+
+def test_a_stuck_sensor_stops_the_clamps_retreat_after_5_cm_and_says_why():
+    cell = StuckSensorCell("ur5", pressed=-0.01)
+    z0 = cell.tip_z()
+    cell.run(0.3, twist=(0.0, 0.0, -0.02, 0.0, 0.0, 0.0))  # a held jog down: the guard holds it, a clamp
+    assert StatusCode.CLAMP_RELEASE in [code for code, _ in cell.statuses]
+    cell.run(3.0, twist=(0.0, 0.0, -0.02, 0.0, 0.0, 0.0))
+    up = cell.tip_z() - z0
+    cell.run(1.0)
+    print(f"\nUR5, a sensor stuck at 60 N: backed off {up * 1e3:.1f} mm, then "
+          f"{(cell.tip_z() - z0) * 1e3:.1f} mm")
+    assert 0.045 < up < 0.06 and abs(cell.tip_z() - z0 - up) < 0.002  # 5 cm, then it stays
+    assert any("backed off 50 mm and the contact force still reads" in m for _, m in cell.statuses)

@@ -26,13 +26,18 @@ class ClampRelease:
         hold: how long [s] |F| must stay at or over `limit`.
         speed: retreat speed [m/s] along the force.
         release: the retreat ends below this |F| [N].
+        travel: the retreat ends after this far [m] whatever the force (a stuck sensor, something that
+            follows the tool): `stuck` says so, and no new clamp is found until |F| is below `release`.
     """
 
-    def __init__(self, limit: float, push_limit: float, hold: float, speed: float, release: float) -> None:
+    def __init__(self, limit: float, push_limit: float, hold: float, speed: float, release: float,
+                 travel: float = math.inf) -> None:
         self.limit, self.push_limit = limit, push_limit
-        self.hold, self.speed, self.release = hold, speed, release
+        self.hold, self.speed, self.release, self.travel = hold, speed, release, travel
         self._over_since: float | None = None
+        self._since = 0.0  # when the clamp being released was found
         self.active = False
+        self.stuck = False  # the last retreat ran its `travel` with the force still at or over `release`
         self.peak = 0.0  # the largest |F| of the clamp being released [N]
         self.by_push = False  # it was found over `push_limit` (not over `limit`)
 
@@ -60,16 +65,22 @@ class ClampRelease:
         if not math.isfinite(magnitude):
             self._over_since = None
             return None
+        if self.stuck:
+            self.stuck = magnitude >= self.release
+            return None
         if self.active:
             if magnitude < self.release:
                 self.active, self._over_since = False, None
+                return None
+            if (t - self._since) * self.speed >= self.travel:
+                self.active, self.stuck, self._over_since = False, True, None
                 return None
         elif magnitude >= (min(self.limit, self.push_limit) if pushed else self.limit):
             if self._over_since is None:
                 self._over_since = t
             if t - self._over_since < self.hold:
                 return None
-            self.active, self.peak, self.by_push = True, 0.0, magnitude < self.limit
+            self.active, self.peak, self.by_push, self._since = True, 0.0, magnitude < self.limit, t
         else:
             self._over_since = None
             return None

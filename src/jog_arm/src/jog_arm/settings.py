@@ -250,6 +250,10 @@ class JogSettings:
         "it back (slows or stops it) is a clamp (README: [clamping](#clamping))",
     )
     clamp_release_speed: float = _pos(0.02, "m/s", "a clamp is released backing off along the force at this")
+    clamp_release_travel: float = _pos(
+        0.05, "m", "a clamp's retreat stops after this far even if the force stays high (a stuck sensor) and "
+        "says so (a guess: ten times the 3-4 mm a release takes on the simulated hand)",
+    )
     contact_stop_scale: float = param(
         5.0, ge=1.0,
         doc="a push the contact guard stops at its limit, and a clamp, brake at this multiple of the joints' "
@@ -387,7 +391,7 @@ TUNABLE = (
     "singularity_threshold", "hard_stop_singularity_threshold", "pinv_damping", "pinv_damping_threshold",
     "contact_guard_max_force", "contact_guard_slow_force", "contact_guard_slow_speed",
     "contact_guard_timeout", "contact_guard_relief_speed", "collaborative_region", "collaborative_payload",
-    "clamp_hold", "clamp_push_force", "clamp_release_speed", "clamp_release_force",
+    "clamp_hold", "clamp_push_force", "clamp_release_speed", "clamp_release_force", "clamp_release_travel",
 )
 
 

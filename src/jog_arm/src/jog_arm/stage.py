@@ -130,7 +130,7 @@ class JogStage:
         self._guard_note = ""
         self._guard_acted = False
         self.clamp = ClampRelease(math.inf, math.inf, s.clamp_hold, s.clamp_release_speed,
-                                  s.clamp_release_force)
+                                  s.clamp_release_force, s.clamp_release_travel)
         self._push_held = -math.inf  # when the contact guard last held a push into the contact back
         self._last_guarded = -math.inf  # when the last guarded (outside) twist arrived
         self._await_pause = False  # after a clamp: pushes into it are ignored until their stream pauses
@@ -153,6 +153,7 @@ class JogStage:
         c = self.clamp
         c.limit = math.inf if s.collaborative_region == OFF else region_named(s.collaborative_region).force
         c.hold, c.speed, c.release = s.clamp_hold, s.clamp_release_speed, s.clamp_release_force
+        c.travel = s.clamp_release_travel
         c.push_limit = s.clamp_push_force if s.contact_guard_enabled else math.inf
 
     # --- inputs ---
@@ -262,10 +263,17 @@ class JogStage:
                 clamp.active = self.jog.braking = False
                 self.jog.drop_command(f"clamp released (peak {clamp.peak:.0f} N)")
                 self._await_pause = True
-                self._fault_note = (f"clamp released below {clamp.release:g} N (peak {clamp.peak:.0f} N); "
-                                    "pushes into it wait until they pause (let go of the key)")
+                if clamp.stuck:  # the force did not fall: not a contact the retreat can leave
+                    self._fault_note = (
+                        f"clamp: backed off {clamp.travel * 1e3:.0f} mm and the contact force still reads "
+                        f"{clamp.release:g} N or more (peak {clamp.peak:.0f} N): stopped; check the force "
+                        "sensor (its zero) or what follows the tool; pushes into it wait until they pause")
+                else:
+                    self._fault_note = (
+                        f"clamp released below {clamp.release:g} N (peak {clamp.peak:.0f} N); pushes into it "
+                        "wait until they pause (let go of the key)")
                 self._fault_shown_until = self._monotonic() + NOTE_SHOWN_FOR
-                self.notes.append(("warn", self._fault_note))
+                self.notes.append(("error" if clamp.stuck else "warn", self._fault_note))
             return False
         s = self.settings
         root, v = s.planning_frame, retreat
