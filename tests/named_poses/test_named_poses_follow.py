@@ -34,6 +34,9 @@ BLOCK_TOP = 0.13  # [m] ur5_custom's block (sim.yaml); the start pose's tool tip
 def arm(ros_node):
     with run_launch("ur5_custom", "sim.launch") as h:
         h.wait_for_service("/named_poses/move_to", timeout=60)
+        # jog_arm's dynamic_reconfigure server writes its values to the parameter server as it starts: a
+        # region set before that (the speed-cap test) would be overwritten.
+        h.wait_for_service("/jog_arm_server/set_parameters", timeout=60)
         client = actionlib.SimpleActionClient("/named_poses/follow_joint_trajectory",
                                               FollowJointTrajectoryAction)
         assert client.wait_for_server(rospy.Duration(30.0))
